@@ -1,0 +1,63 @@
+// Strict access to a YAML config: every read names its key, every error names
+// the file, line, key path and reason, and keys nobody read are reported as
+// unknown. A rig must not start on a config it half understood.
+#pragma once
+
+#include <yaml-cpp/yaml.h>
+
+#include <limits>
+#include <memory>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace rigctl {
+
+class ConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+class ConfigReader {
+ public:
+  // Loads the file; throws ConfigError on I/O or YAML syntax errors.
+  static ConfigReader load(const std::string& path);
+  static ConfigReader from_string(const std::string& text, const std::string& name);
+
+  bool has(const std::string& key) const;
+
+  double number(const std::string& key, double min = -std::numeric_limits<double>::infinity(),
+                double max = std::numeric_limits<double>::infinity());
+  int64_t integer(const std::string& key, int64_t min, int64_t max);
+  bool boolean(const std::string& key);
+  std::string text(const std::string& key);
+  std::string choice(const std::string& key, const std::vector<std::string>& allowed);
+  std::vector<double> numbers(const std::string& key, std::size_t min_count, std::size_t max_count,
+                              double min = -std::numeric_limits<double>::infinity(),
+                              double max = std::numeric_limits<double>::infinity());
+  ConfigReader child(const std::string& key);
+  // Keys of a mapping child, in file order (for maps keyed by channel name).
+  std::vector<std::string> keys() const;
+
+  // Throws for any key of this mapping that was never read.
+  void reject_unknown_keys() const;
+
+  // An error about `key` of this node, with file, line and full key path.
+  [[noreturn]] void fail(const std::string& key, const std::string& reason) const;
+
+  const std::string& file() const { return *file_; }
+  std::string path_of(const std::string& key) const;
+
+ private:
+  ConfigReader(YAML::Node node, std::shared_ptr<const std::string> file, std::string path);
+  YAML::Node required(const std::string& key);
+  [[noreturn]] void fail_at(const YAML::Node& node, const std::string& key, const std::string& reason) const;
+
+  YAML::Node node_;
+  std::shared_ptr<const std::string> file_;
+  std::string path_;  // dotted path of this node, "" for the root
+  std::shared_ptr<std::set<std::string>> used_;
+};
+
+}  // namespace rigctl

@@ -1,0 +1,79 @@
+// The whole configuration of one rig run, parsed and checked. Everything here
+// is SI; conversions (degrees, channel names to indices) happen at load.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "drivers/sensor_model.hpp"
+#include "plant/quarter_car_params.hpp"
+#include "rt/pi_controller.hpp"
+#include "rt/realtime.hpp"
+#include "rt/timing_stats.hpp"
+
+namespace rigctl {
+
+// Rig kinds this build knows; others are a config error naming the list.
+inline const std::vector<std::string>& known_rig_kinds() {
+  static const std::vector<std::string> kinds{"quarter_car"};
+  return kinds;
+}
+
+struct LoopConfig {
+  double period_s = 0.0025;
+  OverrunPolicy overrun_policy = OverrunPolicy::kSkip;
+  double timing_publish_s = 1.0;
+  RealtimeConfig realtime;
+};
+
+struct TelemetryConfig {
+  std::string lcm_url = "memq://";
+  std::string channel_prefix = "RIGCTL_";
+  std::string log_dir = "runs";
+};
+
+struct ControllerConfig {
+  std::string type = "pi";
+  std::string feedback;  // input channel name
+  std::string output;    // output channel name
+  PiConfig pi;           // channel indices resolved when the rig is assembled
+};
+
+struct ProfileConfig {
+  std::string type = "ramp_steps";  // ramp_steps | sine | csv
+  double filter_tau_s = 0.0;
+  // ramp_steps and sine
+  double start = 0.0, hold_s = 0.0, ramp_target = 0.0, ramp_rate = 0.0;
+  std::vector<double> steps;  // ramp_steps
+  double step_hold_s = 0.0;
+  double amplitude = 0.0, frequency_hz = 0.0, cycles = 0.0;  // sine
+  std::string csv_file;    // csv: path resolved against the config's folder
+  std::string csv_column;  // csv: column with the demand
+};
+
+struct LimitConfig {
+  std::string channel;
+  double min = 0.0, max = 0.0;
+};
+
+struct RigConfig {
+  std::string file;
+  std::string rig;
+  std::string driver = "sim";
+  uint64_t seed = 1;
+  LoopConfig loop;
+  TelemetryConfig telemetry;
+  ControllerConfig controller;
+  ProfileConfig profile;
+  std::vector<LimitConfig> limits;
+  QuarterCarParams quarter_car;
+  std::map<std::string, SensorSpec> sensors;  // by channel name
+};
+
+// Throws ConfigError naming file, line, key and reason.
+RigConfig load_rig_config(const std::string& path);
+RigConfig parse_rig_config(const std::string& yaml_text, const std::string& name);
+
+}  // namespace rigctl

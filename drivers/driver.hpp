@@ -1,0 +1,40 @@
+// The one interface between the loop and a rig. The simulated plant, the
+// Modbus DAQ and the CANopen valve all sit behind it; the loop cannot tell
+// them apart.
+#pragma once
+
+#include "rt/sample.hpp"
+
+namespace rigctl {
+
+class Driver {
+ public:
+  virtual ~Driver() = default;
+
+  // Names and SI units of what read() fills and write() takes. Fixed after start().
+  virtual const ChannelLayout& layout() const = 0;
+
+  // Opens devices, connects, primes the plant. Not real-time; may throw.
+  virtual void start() = 0;
+
+  // Real-time path: fills `out` with the latest inputs in SI units. Must not
+  // allocate, lock or block beyond the device's own bounded I/O. Returns false
+  // when no usable sample could be had this tick.
+  virtual bool read(Sample& out) = 0;
+
+  // Real-time path: hands the outputs to the rig.
+  virtual void write(const Command& command) = 0;
+
+  // Puts the outputs in their safe state (valve to null). Called on every way
+  // out of the loop, including faults; must not throw.
+  virtual void make_safe() noexcept = 0;
+
+  // Closes devices. Not real-time.
+  virtual void stop() = 0;
+
+  // True when time is simulated, so the loop may run faster than real time
+  // (--fast) with identical results.
+  virtual bool simulated() const { return false; }
+};
+
+}  // namespace rigctl

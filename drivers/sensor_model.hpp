@@ -1,0 +1,31 @@
+// What a transducer and its ADC do to a true signal: offset, Gaussian noise,
+// clipping to the range and quantisation to the converter's resolution.
+#pragma once
+
+#include <random>
+
+namespace rigctl {
+
+struct SensorSpec {
+  double noise_sd = 0.0;  // [SI unit of the channel]
+  int bits = 0;           // ADC resolution; 0 = not quantised
+  double range_min = 0.0;  // [SI] ADC full scale; used when bits > 0
+  double range_max = 0.0;
+  double offset = 0.0;     // [SI] added to the true value
+};
+
+class SensorModel {
+ public:
+  SensorModel() = default;
+  explicit SensorModel(const SensorSpec& spec);
+  // Allocation free; draws from the caller's generator so one seed makes the
+  // whole run reproducible.
+  double measure(double truth, std::mt19937_64& rng) const noexcept;
+  double lsb() const noexcept { return lsb_; }
+
+ private:
+  SensorSpec spec_;
+  double lsb_ = 0.0;
+};
+
+}  // namespace rigctl

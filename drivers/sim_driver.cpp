@@ -1,0 +1,51 @@
+#include "drivers/sim_driver.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace rigctl {
+
+SimDriver::SimDriver(std::unique_ptr<SimulatedPlant> plant, std::vector<SensorSpec> sensors, double period_s,
+                     uint64_t seed, std::vector<double> safe_command)
+    : plant_(std::move(plant)), period_s_(period_s), period_ns_(static_cast<int64_t>(period_s * 1e9 + 0.5)), seed_(seed), safe_command_(std::move(safe_command)) {
+  layout_.inputs = plant_->signals();
+  layout_.outputs = plant_->commands();
+  if (layout_.inputs.size() > kMaxInputs) throw std::invalid_argument("plant has more signals than a Sample holds");
+  if (layout_.outputs.size() > kMaxOutputs) throw std::invalid_argument("plant has more commands than a Command holds");
+  if (sensors.size() != layout_.inputs.size()) throw std::invalid_argument("one sensor spec per plant signal is needed");
+  if (safe_command_.size() != layout_.outputs.size()) throw std::invalid_argument("safe command size differs from outputs");
+  for (const auto& s : sensors) sensors_.emplace_back(s);
+  command_ = safe_command_;
+  truth_.assign(layout_.inputs.size(), 0.0);
+}
+
+void SimDriver::start() {
+  plant_->reset();
+  rng_.seed(seed_);
+  command_ = safe_command_;
+  tick_ = 0;
+  started_ = false;
+}
+
+bool SimDriver::read(Sample& out) {
+  // The command written on the previous tick acts over the period that just
+  // ended (zero-order hold, as a DAC does).
+  if (started_) {
+    plant_->advance(command_, period_s_);
+    ++tick_;
+  }
+  started_ = true;
+  plant_->measure(truth_);
+  out.t_ns = tick_ * period_ns_;
+  out.status = 0;
+  for (std::size_t i = 0; i < truth_.size(); ++i) out.value[i] = sensors_[i].measure(truth_[i], rng_);
+  return true;
+}
+
+void SimDriver::write(const Command& command) {
+  for (std::size_t i = 0; i < command_.size(); ++i) command_[i] = command.value[i];
+}
+
+void SimDriver::make_safe() noexcept { std::copy(safe_command_.begin(), safe_command_.end(), command_.begin()); }
+
+}  // namespace rigctl

@@ -1,0 +1,39 @@
+// Process and thread set-up for real-time operation: lock memory, SCHED_FIFO,
+// CPU affinity, and hold the CPU out of deep idle states. Each step that the
+// system refuses (not root, no rtprio limit) becomes a warning: the loop then
+// runs best effort rather than not at all.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace rigctl {
+
+struct RealtimeConfig {
+  bool enabled = true;
+  int priority = 80;           // SCHED_FIFO priority 1..99
+  bool lock_memory = true;     // mlockall(MCL_CURRENT | MCL_FUTURE)
+  int cpu = -1;                // pin the loop thread to this CPU; -1 = no pinning
+  bool hold_cpu_dma_latency = true;  // keep /dev/cpu_dma_latency at 0 while running
+};
+
+// Holds what was acquired (the cpu_dma_latency file) until destroyed.
+class RealtimeSession {
+ public:
+  // Applies the config to the calling thread (call it from the loop thread,
+  // after other threads are started: they keep normal priority).
+  explicit RealtimeSession(const RealtimeConfig& config);
+  ~RealtimeSession();
+  RealtimeSession(const RealtimeSession&) = delete;
+  RealtimeSession& operator=(const RealtimeSession&) = delete;
+
+  const std::vector<std::string>& warnings() const { return warnings_; }
+  const std::vector<std::string>& applied() const { return applied_; }
+
+ private:
+  std::vector<std::string> warnings_;
+  std::vector<std::string> applied_;
+  int dma_latency_fd_ = -1;
+};
+
+}  // namespace rigctl

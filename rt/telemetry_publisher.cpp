@@ -1,0 +1,277 @@
+// Publisher thread: drains the real-time loop's queue, turns each record into
+// LCM messages, publishes them and writes the same bytes into an LCM log.
+#include "rt/telemetry_publisher.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <stdexcept>
+#include <system_error>
+
+#include <lcm/lcm-cpp.hpp>
+#include <spdlog/spdlog.h>
+
+#include "rigctl/command_t.hpp"
+#include "rigctl/controller_t.hpp"
+#include "rigctl/sample_t.hpp"
+#include "rigctl/state_t.hpp"
+#include "rigctl/timing_t.hpp"
+
+namespace rigctl {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// A crash (or SIGKILL) of the process loses what is still in stdio's buffer;
+// flushing it to the kernel at least this often bounds that loss to ~1 s of
+// telemetry. (It is not an fsync: a power cut may lose more.)
+constexpr auto kLogFlushInterval = std::chrono::seconds(1);
+constexpr auto kIdleSleep = std::chrono::milliseconds(1);
+
+std::string_view event_name(EventCode code) {
+  switch (code) {
+    case EventCode::kNone: return "";
+    case EventCode::kRunStarted: return "run_started";
+    case EventCode::kProfileFinished: return "profile_finished";
+    case EventCode::kStopRequested: return "stop_requested";
+    case EventCode::kLimitTripped: return "limit_tripped";
+    case EventCode::kInputInvalid: return "input_invalid";
+    case EventCode::kDriverReadFailed: return "driver_read_failed";
+    case EventCode::kQueueOverflow: return "queue_overflow";
+  }
+  return "unknown";
+}
+
+std::string format_g(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+// Human-readable text of an event; the record carries only codes so that the
+// real-time side never formats strings.
+std::string event_message(const Event& ev, const ChannelLayout& layout) {
+  std::string channel;
+  std::string unit;
+  if (ev.channel >= 0 && static_cast<std::size_t>(ev.channel) < layout.inputs.size()) {
+    channel = layout.inputs[ev.channel].name;
+    unit = layout.inputs[ev.channel].unit;
+  } else if (ev.channel >= 0) {
+    channel = "input " + std::to_string(ev.channel);
+  }
+  const std::string value = format_g(ev.value) + (unit.empty() ? "" : " " + unit);
+  switch (ev.code) {
+    case EventCode::kNone: return "";
+    case EventCode::kRunStarted: return "run started";
+    case EventCode::kProfileFinished: return "profile finished";
+    case EventCode::kStopRequested: return "stop requested";
+    // The limits themselves are not in the record: name channel and value.
+    case EventCode::kLimitTripped: return channel + " = " + value + " outside its limits";
+    case EventCode::kInputInvalid: return channel + " invalid (value " + value + ")";
+    case EventCode::kDriverReadFailed:
+      return channel.empty() ? "driver read failed" : "driver read failed on " + channel;
+    case EventCode::kQueueOverflow: return "telemetry queue dropped " + format_g(ev.value) + " records";
+  }
+  return "unknown event";
+}
+
+// The one place a message is encoded, published and logged, so that the log
+// holds exactly the bytes that went onto the bus.
+template <typename Msg>
+void emit(lcm::LCM& lcm, lcm::LogFile* log, const std::string& channel, int64_t utime, const Msg& msg) {
+  const int size = msg.getEncodedSize();
+  std::vector<uint8_t> buf(static_cast<std::size_t>(size));
+  if (msg.encode(buf.data(), 0, size) != size) {
+    spdlog::error("telemetry: encoding a message for {} failed", channel);
+    return;
+  }
+  if (lcm.publish(channel, buf.data(), static_cast<unsigned int>(size)) != 0) {
+    // A broken bus fails on every tick: warn on the first and every 10000th.
+    static std::atomic<int64_t> failures{0};
+    if (failures.fetch_add(1) % 10000 == 0) spdlog::warn("telemetry: publish on {} failed", channel);
+  }
+  if (log != nullptr) {
+    lcm::LogEvent ev{};
+    ev.timestamp = utime;
+    ev.channel = channel;
+    ev.datalen = size;
+    ev.data = buf.data();
+    if (log->writeEvent(&ev) != 0) {
+      static std::atomic<int64_t> failures{0};
+      if (failures.fetch_add(1) % 10000 == 0) spdlog::warn("telemetry: writing the log failed: {}", std::strerror(errno));
+    }
+  }
+}
+
+}  // namespace
+
+TelemetryPublisher::TelemetryPublisher(TelemetryMeta meta, const std::string& lcm_url,
+                                       const std::string& log_path, std::size_t queue_capacity)
+    : meta_(std::move(meta)), channels_(meta_.channel_prefix), queue_(queue_capacity) {
+  // An empty URL would make LCM fall back to its default multicast group:
+  // never do that by accident.
+  if (lcm_url.empty()) throw std::runtime_error("telemetry: no LCM URL given (e.g. memq:// or udpm://...)");
+  lcm_ = std::make_unique<lcm::LCM>(lcm_url);
+  if (!lcm_->good()) throw std::runtime_error("telemetry: cannot open LCM URL '" + lcm_url + "'");
+  if (!log_path.empty()) {
+    const std::filesystem::path parent = std::filesystem::path(log_path).parent_path();
+    std::error_code ec;
+    if (!parent.empty()) std::filesystem::create_directories(parent, ec);
+    if (ec) {
+      throw std::runtime_error("telemetry: cannot create the directory of log '" + log_path + "': " + ec.message());
+    }
+    log_ = std::make_unique<lcm::LogFile>(log_path, "w");
+    if (!log_->good()) {
+      const int err = errno;
+      throw std::runtime_error("telemetry: cannot open log '" + log_path + "' for writing: " + std::strerror(err));
+    }
+  }
+}
+
+TelemetryPublisher::~TelemetryPublisher() { stop(); }
+
+bool TelemetryPublisher::push(const TelemetryRecord& record) noexcept {
+  if (queue_.try_push(record)) return true;
+  dropped_.fetch_add(1, std::memory_order_relaxed);
+  return false;
+}
+
+void TelemetryPublisher::start() {
+  if (thread_.joinable()) return;
+  running_.store(true);
+  thread_ = std::thread([this] { thread_main(); });
+}
+
+void TelemetryPublisher::stop() {
+  running_.store(false);
+  if (thread_.joinable()) thread_.join();
+  // Whatever the loop pushed before stop() still goes out (also when the
+  // thread was never started).
+  TelemetryRecord record;
+  while (queue_.try_pop(record)) publish_record(record);
+  log_.reset();  // lcm_eventlog_destroy flushes and closes the file
+}
+
+lcm::LCM& TelemetryPublisher::lcm() { return *lcm_; }
+
+void TelemetryPublisher::thread_main() {
+  auto last_flush = Clock::now();
+  TelemetryRecord record;
+  while (running_.load()) {
+    const bool got = queue_.try_pop(record);
+    if (got) publish_record(record);
+    const auto now = Clock::now();
+    if (log_ && now - last_flush >= kLogFlushInterval) {
+      std::fflush(log_->getFilePtr());
+      last_flush = now;
+    }
+    // Polling, not a condition variable: the real-time side must never make
+    // a system call to wake us.
+    if (!got) std::this_thread::sleep_for(kIdleSleep);
+  }
+}
+
+void TelemetryPublisher::publish_record(const TelemetryRecord& r) {
+  const int64_t utime = meta_.start_utime + r.sample.t_ns / 1000;
+  const double t = static_cast<double>(r.sample.t_ns) * 1e-9;
+  lcm::LogFile* log = log_.get();
+  const ChannelLayout& layout = meta_.layout;
+
+  rigctl::sample_t s;
+  s.utime = utime;
+  s.tick = r.tick;
+  s.t = t;
+  s.rig = meta_.rig;
+  s.status = static_cast<int32_t>(r.sample.status);
+  const std::size_t n_in = std::min(layout.inputs.size(), kMaxInputs);
+  s.num_channels = static_cast<int16_t>(n_in);
+  for (std::size_t i = 0; i < n_in; ++i) {
+    s.names.push_back(layout.inputs[i].name);
+    s.units.push_back(layout.inputs[i].unit);
+    s.values.push_back(r.sample.value[i]);
+  }
+  emit(*lcm_, log, channels_.sample, utime, s);
+
+  rigctl::command_t c;
+  c.utime = utime;
+  c.tick = r.tick;
+  c.t = t;
+  c.setpoint_name = meta_.setpoint_name;
+  c.setpoint = r.controller.setpoint;
+  const std::size_t n_out = std::min(layout.outputs.size(), kMaxOutputs);
+  c.num_outputs = static_cast<int16_t>(n_out);
+  for (std::size_t i = 0; i < n_out; ++i) {
+    c.names.push_back(layout.outputs[i].name);
+    c.units.push_back(layout.outputs[i].unit);
+    c.values.push_back(r.command.value[i]);
+  }
+  emit(*lcm_, log, channels_.command, utime, c);
+
+  rigctl::controller_t k;
+  k.utime = utime;
+  k.tick = r.tick;
+  k.t = t;
+  k.controller = meta_.controller_name;
+  k.setpoint = r.controller.setpoint;
+  k.measurement = r.controller.measurement;
+  k.error = r.controller.error;
+  const std::size_t n_terms = std::min(meta_.term_names.size(), kMaxControllerTerms);
+  k.num_terms = static_cast<int16_t>(n_terms);
+  k.term_names.assign(meta_.term_names.begin(), meta_.term_names.begin() + n_terms);
+  k.terms.assign(r.controller.term.begin(), r.controller.term.begin() + n_terms);
+  k.output_unsaturated = r.controller.output_unsaturated;
+  k.output = r.controller.output;
+  k.saturated = r.controller.saturated;
+  k.integrator_held = r.controller.integrator_held;
+  emit(*lcm_, log, channels_.controller, utime, k);
+
+  if (first_record_ || r.state != last_state_ || r.event.code != EventCode::kNone) {
+    rigctl::state_t st;
+    st.utime = utime;
+    st.tick = r.tick;
+    st.t = t;
+    st.state = std::string(to_string(r.state));
+    st.event = std::string(event_name(r.event.code));
+    st.message = event_message(r.event, layout);
+    emit(*lcm_, log, channels_.state, utime, st);
+    first_record_ = false;
+    last_state_ = r.state;
+  }
+
+  if (r.has_timing) {
+    const TimingSummary& tm = r.timing;
+    rigctl::timing_t m;
+    m.utime = utime;
+    m.tick = r.tick;
+    m.period_ns = tm.period_ns;
+    m.overrun_policy = meta_.overrun_policy;
+    m.ticks = tm.ticks;
+    m.overruns = tm.overruns;
+    m.missed_ticks = tm.missed_ticks;
+    m.dropped_records = dropped();
+    m.latency_count = tm.wakeup_latency.count;
+    m.latency_min_ns = tm.wakeup_latency.min_ns;
+    m.latency_max_ns = tm.wakeup_latency.max_ns;
+    m.latency_mean_ns = tm.wakeup_latency.mean_ns;
+    m.latency_p50_ns = tm.wakeup_latency.p50_ns;
+    m.latency_p99_ns = tm.wakeup_latency.p99_ns;
+    m.latency_p999_ns = tm.wakeup_latency.p999_ns;
+    m.compute_count = tm.compute.count;
+    m.compute_min_ns = tm.compute.min_ns;
+    m.compute_max_ns = tm.compute.max_ns;
+    m.compute_mean_ns = tm.compute.mean_ns;
+    m.compute_p50_ns = tm.compute.p50_ns;
+    m.compute_p99_ns = tm.compute.p99_ns;
+    m.compute_p999_ns = tm.compute.p999_ns;
+    emit(*lcm_, log, channels_.timing, utime, m);
+  }
+
+  // Counts records (the unit dropped() counts), not LCM messages.
+  published_.fetch_add(1, std::memory_order_relaxed);
+}
+
+}  // namespace rigctl

@@ -1,0 +1,90 @@
+// The non-real-time side of telemetry: a thread that drains the loop's
+// lock-free queue, encodes LCM messages, publishes them on the configured LCM
+// URL and writes the same events into an LCM log file (lcm-logger format).
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "rt/sample.hpp"
+#include "rt/spsc_queue.hpp"
+#include "rt/telemetry_record.hpp"
+#include "rt/telemetry_sink.hpp"
+
+namespace lcm {
+class LCM;
+class LogFile;
+}  // namespace lcm
+
+namespace rigctl {
+
+// Fixed facts about a run that every message needs; set once before start().
+struct TelemetryMeta {
+  std::string rig;                 // "quarter_car"
+  ChannelLayout layout;            // names/units of sample inputs and command outputs
+  std::string setpoint_name;       // "x_ref"
+  std::string controller_name;     // "pi"
+  std::vector<std::string> term_names;  // controller terms, e.g. {"p", "i"}
+  std::string channel_prefix = "RIGCTL_";
+  std::string overrun_policy = "skip";
+  int64_t period_ns = 2'500'000;
+  // Wall-clock time of tick 0 [us since the epoch]. Message utime and log
+  // event timestamps are start_utime + rig time, so a --fast run and a paced
+  // run of the same config give the same log apart from this offset, and
+  // lcm-logplayer replays either at the rig's real speed.
+  int64_t start_utime = 0;
+};
+
+// LCM channel names, given the prefix.
+struct TelemetryChannels {
+  std::string sample, command, controller, timing, state;
+  explicit TelemetryChannels(const std::string& prefix)
+      : sample(prefix + "SAMPLE"), command(prefix + "COMMAND"), controller(prefix + "CONTROLLER"),
+        timing(prefix + "TIMING"), state(prefix + "STATE") {}
+};
+
+class TelemetryPublisher final : public TelemetrySink {
+ public:
+  // lcm_url: e.g. "memq://" or "udpm://239.255.76.67:7667?ttl=0". log_path:
+  // LCM log file to write ("" = no log). Throws std::runtime_error naming the
+  // URL or path when either cannot be opened.
+  TelemetryPublisher(TelemetryMeta meta, const std::string& lcm_url, const std::string& log_path,
+                     std::size_t queue_capacity = 8192);
+  ~TelemetryPublisher();
+  TelemetryPublisher(const TelemetryPublisher&) = delete;
+  TelemetryPublisher& operator=(const TelemetryPublisher&) = delete;
+
+  // Real-time side: never blocks. Returns false and counts a drop when full.
+  bool push(const TelemetryRecord& record) noexcept override;
+
+  void start();  // starts the publisher thread
+  void stop();   // drains the queue, flushes and closes the log, joins the thread
+
+  int64_t published() const { return published_.load(); }
+  int64_t dropped() const { return dropped_.load(); }
+  const TelemetryChannels& channels() const { return channels_; }
+  // The LCM instance, so in-process subscribers (memq://) can share it.
+  lcm::LCM& lcm();
+
+ private:
+  void thread_main();
+  void publish_record(const TelemetryRecord& record);
+
+  TelemetryMeta meta_;
+  TelemetryChannels channels_;
+  std::unique_ptr<lcm::LCM> lcm_;
+  std::unique_ptr<lcm::LogFile> log_;
+  SpscQueue<TelemetryRecord> queue_;
+  std::thread thread_;
+  std::atomic<bool> running_{false};
+  std::atomic<int64_t> published_{0};
+  std::atomic<int64_t> dropped_{0};
+  RigState last_state_ = RigState::kStarting;
+  bool first_record_ = true;
+};
+
+}  // namespace rigctl

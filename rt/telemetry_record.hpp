@@ -1,0 +1,78 @@
+// What the real-time loop hands to the publisher thread on every tick. Plain
+// data of fixed size, so that pushing it into the lock-free queue is a copy.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string_view>
+
+#include "rt/rig_state.hpp"
+#include "rt/sample.hpp"
+#include "rt/timing_summary.hpp"
+
+namespace rigctl {
+
+inline constexpr std::size_t kMaxControllerTerms = 8;
+
+// The controller's inside view for one tick; term names come from
+// Controller::term_names(), fixed at start-up.
+struct ControllerTerms {
+  double setpoint = 0.0;
+  double measurement = 0.0;
+  double error = 0.0;
+  std::array<double, kMaxControllerTerms> term{};  // e.g. P part, I part
+  double output_unsaturated = 0.0;
+  double output = 0.0;
+  bool saturated = false;
+  bool integrator_held = false;  // anti-windup is holding the integrator this tick
+};
+
+// Something that happened on this tick. Codes, not text: the publisher
+// formats the message off the real-time path.
+enum class EventCode : uint8_t {
+  kNone,
+  kRunStarted,
+  kProfileFinished,
+  kStopRequested,    // SIGINT/SIGTERM or --duration reached
+  kLimitTripped,     // input `channel` left its range with `value`
+  kInputInvalid,     // driver flagged input `channel` invalid (NaN, stale)
+  kDriverReadFailed,
+  kQueueOverflow,    // telemetry records were dropped (value = count)
+};
+
+constexpr std::string_view to_string(EventCode c) {
+  switch (c) {
+    case EventCode::kNone: return "";
+    case EventCode::kRunStarted: return "run_started";
+    case EventCode::kProfileFinished: return "profile_finished";
+    case EventCode::kStopRequested: return "stop_requested";
+    case EventCode::kLimitTripped: return "limit_tripped";
+    case EventCode::kInputInvalid: return "input_invalid";
+    case EventCode::kDriverReadFailed: return "driver_read_failed";
+    case EventCode::kQueueOverflow: return "queue_overflow";
+  }
+  return "unknown";
+}
+
+struct Event {
+  EventCode code = EventCode::kNone;
+  int16_t channel = -1;  // input index the event is about, -1 when none
+  double value = 0.0;
+};
+
+struct TelemetryRecord {
+  int64_t tick = 0;
+  // False on the record that closes a run: it carries only state, event and
+  // timing, no sample/command/controller messages (the tick never ran).
+  bool has_sample = true;
+  Sample sample;
+  Command command;
+  ControllerTerms controller;
+  RigState state = RigState::kRunning;
+  Event event;
+  // Set on the ticks where the loop publishes its timing statistics.
+  bool has_timing = false;
+  TimingSummary timing;
+};
+
+}  // namespace rigctl

@@ -1,0 +1,118 @@
+// Bad config never starts a rig: each kind of mistake gives its own error
+// naming the file, the key and the reason.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include "config/config_reader.hpp"
+#include "config/rig_config.hpp"
+#include "tools/rig_assembly.hpp"
+
+using namespace rigctl;
+
+namespace {
+std::string shipped_config() {
+  std::ifstream in(std::string(RIGCTL_SOURCE_DIR) + "/config/quarter_car.yaml");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// Replaces the first line matching `pattern` (regex over one line).
+std::string edit(const std::string& text, const std::string& pattern, const std::string& replacement) {
+  const std::regex re(pattern);
+  std::string out = std::regex_replace(text, re, replacement, std::regex_constants::format_first_only);
+  EXPECT_NE(out, text) << "pattern not found: " << pattern;
+  return out;
+}
+
+std::string error_of(const std::string& yaml) {
+  try {
+    const auto config = parse_rig_config(yaml, "bad.yaml");
+    assemble_rig(config);
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+void expect_error(const std::string& yaml, const std::vector<std::string>& fragments) {
+  const std::string e = error_of(yaml);
+  ASSERT_FALSE(e.empty()) << "config was accepted";
+  for (const auto& f : fragments) EXPECT_NE(e.find(f), std::string::npos) << "'" << f << "' not in: " << e;
+}
+}  // namespace
+
+TEST(RigConfig, ShippedConfigLoadsWithThePapersModel) {
+  const auto c = load_rig_config(std::string(RIGCTL_SOURCE_DIR) + "/config/quarter_car.yaml");
+  EXPECT_EQ(c.rig, "quarter_car");
+  EXPECT_TRUE(c.quarter_car.bearing_friction.enabled);
+  EXPECT_NEAR(c.quarter_car.bearing_friction.construction_angle, 62.0 * M_PI / 180.0, 1e-12);  // degrees converted
+  EXPECT_DOUBLE_EQ(c.loop.period_s, 0.0025);
+  ASSERT_EQ(c.profile.steps.size(), 4u);
+  EXPECT_DOUBLE_EQ(c.profile.steps[0], 0.05);
+  EXPECT_EQ(c.sensors.size(), 8u);
+  EXPECT_NO_THROW(assemble_rig(c));
+}
+
+TEST(RigConfig, UnknownKey) {
+  expect_error(edit(shipped_config(), "  kp: 80.0", "  kp: 80.0\n  kd: 1.0"),
+               {"bad.yaml:", "controller.kd", "unknown key"});
+}
+
+TEST(RigConfig, MissingKey) {
+  expect_error(edit(shipped_config(), "  ki: 60.0[^\n]*\n", ""), {"bad.yaml:", "controller.ki", "missing required key"});
+}
+
+TEST(RigConfig, WrongType) {
+  expect_error(edit(shipped_config(), "  period_s: 0.0025", "  period_s: fast"),
+               {"bad.yaml:", "loop.period_s", "expected a number", "'fast'"});
+  expect_error(edit(shipped_config(), "    leakage: true", "    leakage: maybe"),
+               {"plant.hydraulics.leakage", "expected true or false"});
+}
+
+TEST(RigConfig, OutOfRange) {
+  expect_error(edit(shipped_config(), "  period_s: 0.0025", "  period_s: 5"),
+               {"bad.yaml:", "loop.period_s", "must be in [0.0001, 0.1]", "got 5"});
+  expect_error(edit(shipped_config(), "    construction_angle_deg: 62.0", "    construction_angle_deg: 95"),
+               {"plant.bearing_friction.construction_angle_deg", "got 95"});
+}
+
+TEST(RigConfig, UnknownRigKind) {
+  expect_error(edit(shipped_config(), "rig: quarter_car", "rig: quarter_cat"),
+               {"bad.yaml:", "rig", "unknown value 'quarter_cat'", "quarter_car"});
+}
+
+TEST(RigConfig, LineNumberPointsAtTheBadValue) {
+  const std::string yaml = edit(shipped_config(), "  period_s: 0.0025", "  period_s: -1");
+  std::istringstream lines(yaml);
+  std::string line;
+  int n = 0, bad_line = 0;
+  while (std::getline(lines, line)) {
+    ++n;
+    if (line.find("period_s: -1") != std::string::npos) bad_line = n;
+  }
+  expect_error(yaml, {"bad.yaml:" + std::to_string(bad_line) + ":"});
+}
+
+TEST(RigConfig, UnknownChannelNames) {
+  expect_error(edit(shipped_config(), "  feedback: x_r", "  feedback: x_q"),
+               {"controller.feedback", "unknown input channel 'x_q'", "x_r"});
+  expect_error(edit(shipped_config(), "  x_r: \\[-0.012, 0.172\\]", "  x_z: [-0.012, 0.172]"), {"limits.x_z"});
+  expect_error(edit(shipped_config(), "  f_t: \\{", "  f_z: {"), {"sensors.f_z"});
+}
+
+TEST(RigConfig, SyntaxErrorNamesTheLine) {
+  expect_error(edit(shipped_config(), "  kp: 80.0", "  kp: [80.0"), {"bad.yaml:", "YAML syntax error"});
+}
+
+TEST(RigConfig, MissingFile) {
+  try {
+    load_rig_config("/nonexistent/rig.yaml");
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/rig.yaml"), std::string::npos);
+  }
+}

@@ -1,0 +1,75 @@
+// rigctl: one program, one subcommand per job.
+#include <CLI/CLI.hpp>
+#include <spdlog/spdlog.h>
+
+#include <atomic>
+#include <csignal>
+#include <iostream>
+
+#include "config/config_reader.hpp"
+#include "tools/log2csv.hpp"
+#include "tools/run_command.hpp"
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+
+extern "C" void request_stop(int) { g_stop.store(true); }
+
+void install_stop_handlers() {
+  struct sigaction sa {};
+  sa.sa_handler = request_stop;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"rigctl: real-time controller and simulator for servo-hydraulic and pneumatic test rigs"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "rigctl 0.1.0");
+
+  rigctl::RunOptions run;
+  double duration = 0.0;
+  auto* run_cmd = app.add_subcommand("run", "Run the control loop on a rig (simulated by default) with LCM telemetry and a run log");
+  run_cmd->add_option("config", run.config_path, "Rig config (YAML), e.g. config/quarter_car.yaml")->required()->check(CLI::ExistingFile);
+  auto* duration_opt = run_cmd->add_option("--duration", duration, "Run length [s] (default: the profile's length)")->check(CLI::PositiveNumber);
+  run_cmd->add_flag("--fast", run.fast, "Simulated plant only: run as fast as the CPU allows, same results as paced");
+  run_cmd->add_option("--log", run.log_path, "LCM log file to write (default: a new file in the config's log_dir)");
+  run_cmd->add_option("--csv", run.csv_path, "Also write the run as a CSV run file");
+  run_cmd->add_option("--lcm-url", run.lcm_url, "LCM URL, overrides telemetry.lcm_url (e.g. udpm://239.255.76.67:7667?ttl=1)");
+  run_cmd->add_flag("--no-realtime{false}", run.realtime, "Do not try mlockall/SCHED_FIFO");
+
+  std::string log_in, csv_out, prefix = "RIGCTL_";
+  auto* l2c = app.add_subcommand("log2csv", "Convert a run's LCM log into a CSV run file (shared/spec/measured-data.md)");
+  l2c->add_option("log", log_in, "LCM log written by rigctl run")->required();
+  l2c->add_option("csv", csv_out, "CSV file to write")->required();
+  l2c->add_option("--channel-prefix", prefix, "Telemetry channel prefix used by the run");
+
+  CLI11_PARSE(app, argc, argv);
+
+  try {
+    if (run_cmd->parsed()) {
+      if (duration_opt->count() > 0) run.duration_s = duration;
+      install_stop_handlers();
+      const auto report = rigctl::run_rig(run, g_stop, std::cout);
+      return report.loop.final_state == rigctl::RigState::kFaulted ? 3 : 0;
+    }
+    if (l2c->parsed()) {
+      const auto result = rigctl::log_to_csv(log_in, csv_out, prefix);
+      std::cout << "log2csv: " << result.rows << " rows of " << result.rig << " written to " << csv_out;
+      if (result.skipped > 0) std::cout << " (" << result.skipped << " incomplete ticks skipped)";
+      std::cout << "\n";
+      return 0;
+    }
+  } catch (const rigctl::ConfigError& e) {
+    std::cerr << "rigctl: config error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "rigctl: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

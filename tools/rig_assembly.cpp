@@ -1,0 +1,108 @@
+#include "tools/rig_assembly.hpp"
+
+#include "config/config_reader.hpp"
+#include "drivers/sim_driver.hpp"
+#include "plant/quarter_car_plant.hpp"
+#include "rt/pi_controller.hpp"
+
+namespace rigctl {
+
+namespace {
+
+[[noreturn]] void config_fail(const RigConfig& c, const std::string& key, const std::string& reason) {
+  throw ConfigError(c.file + ": " + key + ": " + reason);
+}
+
+std::string channel_list(const std::vector<ChannelInfo>& channels) {
+  std::string s;
+  for (const auto& ch : channels) s += (s.empty() ? "" : ", ") + ch.name;
+  return s;
+}
+
+bool is_truth_channel(const std::string& name) { return name.rfind("sim_", 0) == 0; }
+
+std::vector<SensorSpec> sensor_specs(const RigConfig& c, const std::vector<ChannelInfo>& signals) {
+  for (const auto& [name, spec] : c.sensors) {
+    bool found = false;
+    for (const auto& s : signals) found = found || (s.name == name && !is_truth_channel(name));
+    if (!found) config_fail(c, "sensors." + name, "no such sensor channel on this rig (channels: " + channel_list(signals) + ")");
+  }
+  std::vector<SensorSpec> out;
+  for (const auto& s : signals) {
+    if (is_truth_channel(s.name)) {
+      out.emplace_back();  // simulator truth: exact
+      continue;
+    }
+    const auto it = c.sensors.find(s.name);
+    if (it == c.sensors.end()) config_fail(c, "sensors." + s.name, "missing required key (a sensor model for every channel)");
+    out.push_back(it->second);
+  }
+  return out;
+}
+
+std::unique_ptr<Driver> make_driver(const RigConfig& c) {
+  auto plant = std::make_unique<QuarterCarPlant>(c.quarter_car);
+  auto sensors = sensor_specs(c, plant->signals());
+  std::vector<double> safe(plant->commands().size(), 0.0);  // valve to null
+  return std::make_unique<SimDriver>(std::move(plant), std::move(sensors), c.loop.period_s, c.seed, std::move(safe));
+}
+
+std::unique_ptr<FilteredProfile> make_profile(const RigConfig& c, double& duration) {
+  const auto& p = c.profile;
+  std::unique_ptr<SetpointProfile> raw;
+  const LeadIn lead{p.start, p.ramp_target, p.hold_s, p.ramp_rate};
+  if (p.type == "ramp_steps") {
+    raw = std::make_unique<RampStepsProfile>(lead, p.steps, p.step_hold_s);
+  } else if (p.type == "sine") {
+    raw = std::make_unique<SineProfile>(lead, p.amplitude, p.frequency_hz, p.cycles);
+  } else {
+    try {
+      raw = std::make_unique<TableProfile>(TableProfile::from_csv(p.csv_file, p.csv_column));
+    } catch (const std::exception& e) {
+      config_fail(c, "profile.file", e.what());
+    }
+  }
+  duration = raw->duration();
+  return std::make_unique<FilteredProfile>(std::move(raw), p.filter_tau_s, c.loop.period_s);
+}
+
+}  // namespace
+
+std::string setpoint_name_for(const std::string& rig) {
+  if (rig == "quarter_car") return "x_ref";
+  return "setpoint";
+}
+
+AssembledRig assemble_rig(const RigConfig& c) {
+  AssembledRig rig;
+  rig.driver = make_driver(c);
+  const ChannelLayout& layout = rig.driver->layout();
+
+  PiConfig pi = c.controller.pi;
+  pi.feedback_input = layout.input_index(c.controller.feedback);
+  if (pi.feedback_input < 0) {
+    config_fail(c, "controller.feedback", "unknown input channel '" + c.controller.feedback + "' (inputs: " +
+                                               channel_list(layout.inputs) + ")");
+  }
+  pi.output_index = layout.output_index(c.controller.output);
+  if (pi.output_index < 0) {
+    config_fail(c, "controller.output", "unknown output channel '" + c.controller.output + "' (outputs: " +
+                                             channel_list(layout.outputs) + ")");
+  }
+  rig.controller = std::make_unique<PiController>(pi);
+
+  std::vector<InputLimit> limits;
+  for (const auto& l : c.limits) {
+    const int index = layout.input_index(l.channel);
+    if (index < 0) {
+      config_fail(c, "limits." + l.channel, "unknown input channel (inputs: " + channel_list(layout.inputs) + ")");
+    }
+    limits.push_back({index, l.min, l.max});
+  }
+  rig.limits = LimitCheck(std::move(limits), layout.inputs.size());
+  rig.profile = make_profile(c, rig.profile_duration_s);
+  rig.setpoint_name = setpoint_name_for(c.rig);
+  return rig;
+}
+
+}  // namespace rigctl

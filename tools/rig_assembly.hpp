@@ -1,0 +1,32 @@
+// Builds the parts of a run from a checked config: the driver (with its plant
+// when simulated), the controller, the demand profile and the limit checks,
+// resolving channel names to indices. Name errors are ConfigErrors that name
+// the config key.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "config/rig_config.hpp"
+#include "drivers/driver.hpp"
+#include "rt/controller.hpp"
+#include "rt/limit_check.hpp"
+#include "rt/setpoint_profile.hpp"
+
+namespace rigctl {
+
+struct AssembledRig {
+  std::unique_ptr<Driver> driver;
+  std::unique_ptr<Controller> controller;
+  std::unique_ptr<FilteredProfile> profile;
+  LimitCheck limits;
+  std::string setpoint_name;  // run-file column of the demand, e.g. "x_ref"
+  double profile_duration_s = 0.0;
+};
+
+AssembledRig assemble_rig(const RigConfig& config);
+
+// Run-file name of the demand for a rig kind ("x_ref" for quarter_car).
+std::string setpoint_name_for(const std::string& rig);
+
+}  // namespace rigctl

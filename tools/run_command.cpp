@@ -1,0 +1,150 @@
+#include "tools/run_command.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <filesystem>
+#include <iomanip>
+#include <sstream>
+#include <stdexcept>
+
+#include "config/rig_config.hpp"
+#include "rt/realtime.hpp"
+#include "rt/telemetry_publisher.hpp"
+#include "tools/log2csv.hpp"
+#include "tools/rig_assembly.hpp"
+
+namespace rigctl {
+
+namespace {
+
+int64_t wall_utime_now() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+std::string default_log_path(const std::string& dir, const std::string& rig) {
+  const std::time_t now = std::time(nullptr);
+  std::tm tm{};
+  localtime_r(&now, &tm);
+  std::ostringstream name;
+  name << rig << "-" << std::put_time(&tm, "%Y%m%d-%H%M%S") << ".lcm";
+  std::filesystem::path p = std::filesystem::path(dir) / name.str();
+  // Two runs in the same second must not overwrite each other.
+  for (int i = 2; std::filesystem::exists(p); ++i) {
+    p = std::filesystem::path(dir) / (name.str().substr(0, name.str().size() - 4) + "-" + std::to_string(i) + ".lcm");
+  }
+  return p.string();
+}
+
+std::string describe(const DistributionSummary& d) {
+  std::ostringstream os;
+  os << std::fixed << std::setprecision(1) << "p50 " << d.p50_ns / 1e3 << " us, p99 " << d.p99_ns / 1e3
+     << " us, p99.9 " << d.p999_ns / 1e3 << " us, max " << d.max_ns / 1e3 << " us";
+  return os.str();
+}
+
+}  // namespace
+
+RunReport run_rig(const RunOptions& options, const std::atomic<bool>& stop, std::ostream& out) {
+  const RigConfig config = load_rig_config(options.config_path);
+  AssembledRig rig = assemble_rig(config);
+  if (options.fast && !rig.driver->simulated()) {
+    throw std::runtime_error("--fast needs a simulated driver: '" + config.driver + "' runs real hardware in real time");
+  }
+
+  const double duration = options.duration_s.value_or(rig.profile_duration_s);
+  if (!(duration > 0.0)) throw std::runtime_error("run duration must be positive");
+  LoopOptions loop_options;
+  loop_options.period_ns = std::llround(config.loop.period_s * 1e9);
+  loop_options.overrun_policy = config.loop.overrun_policy;
+  loop_options.max_ticks = std::llround(duration / config.loop.period_s);
+  loop_options.timing_every_ticks = std::max<int64_t>(1, std::llround(config.loop.timing_publish_s / config.loop.period_s));
+
+  RunReport report;
+  report.log_path = options.log_path.empty() ? default_log_path(config.telemetry.log_dir, config.rig) : options.log_path;
+  report.csv_path = options.csv_path;
+
+  TelemetryMeta meta;
+  meta.rig = config.rig;
+  meta.layout = rig.driver->layout();
+  meta.setpoint_name = rig.setpoint_name;
+  meta.controller_name = rig.controller->name();
+  meta.term_names = rig.controller->term_names();
+  meta.channel_prefix = config.telemetry.channel_prefix;
+  meta.overrun_policy = std::string(to_string(config.loop.overrun_policy));
+  meta.period_ns = loop_options.period_ns;
+  meta.start_utime = wall_utime_now();
+  const std::string url = options.lcm_url.empty() ? config.telemetry.lcm_url : options.lcm_url;
+  // Ten seconds of records: the publisher thread would have to stall that
+  // long before the loop drops telemetry.
+  const auto queue_capacity = static_cast<std::size_t>(10.0 / config.loop.period_s);
+  TelemetryPublisher publisher(meta, url, report.log_path, queue_capacity);
+
+  rig.driver->start();
+  publisher.start();  // before the real-time set-up: the publisher keeps normal priority
+
+  out << "rigctl run: " << config.rig << " (" << config.driver << " driver) from " << options.config_path << ", "
+      << duration << " s " << (options.fast ? "as fast as possible" : "paced by the real clock") << "\n"
+      << "  telemetry: " << url << " channels " << config.telemetry.channel_prefix << "*\n";
+  out.flush();
+
+  MonotonicClock monotonic;
+  VirtualClock virtual_clock;
+  LoopClock& clock = options.fast ? static_cast<LoopClock&>(virtual_clock) : monotonic;
+
+  const auto wall_start = std::chrono::steady_clock::now();
+  LoopResult result;
+  {
+    // A --fast run is not paced, so real-time scheduling would only starve
+    // the machine; it is skipped without a warning.
+    RealtimeConfig rt = config.loop.realtime;
+    rt.enabled = rt.enabled && options.realtime;
+    std::optional<RealtimeSession> session;
+    if (!options.fast) {
+      session.emplace(rt);
+      for (const auto& w : session->warnings()) spdlog::warn("{}", w);
+    }
+    RigLoop loop(*rig.driver, *rig.controller, *rig.profile, rig.limits, publisher, clock, loop_options);
+    try {
+      result = loop.run(stop);
+    } catch (...) {
+      publisher.stop();  // keep what was recorded
+      rig.driver->stop();
+      throw;
+    }
+  }
+  report.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  publisher.stop();
+  rig.driver->stop();
+  result.dropped_records = publisher.dropped();
+  report.loop = result;
+
+  const auto& t = result.timing;
+  out << "  ended: " << to_string(result.final_state) << " (" << to_string(result.end_event.code);
+  if (result.end_event.channel >= 0) {
+    out << ": " << meta.layout.inputs[static_cast<std::size_t>(result.end_event.channel)].name << " = "
+        << result.end_event.value;
+  }
+  out << ") after " << result.ticks << " ticks ("
+      << std::fixed << std::setprecision(3) << static_cast<double>(result.ticks) * config.loop.period_s
+      << " s rig time, " << report.wall_s << " s wall)\n";
+  if (!options.fast) {
+    out << "  wake-up latency: " << describe(t.wakeup_latency) << "\n"
+        << "  compute per tick: " << describe(t.compute) << "\n"
+        << "  overruns: " << t.overruns << " (missed ticks " << t.missed_ticks << ", policy "
+        << to_string(config.loop.overrun_policy) << ")\n";
+  }
+  if (report.loop.dropped_records > 0) out << "  telemetry records dropped: " << report.loop.dropped_records << "\n";
+  out << "  log: " << report.log_path << "\n";
+  if (!report.csv_path.empty()) {
+    const auto csv = log_to_csv(report.log_path, report.csv_path, config.telemetry.channel_prefix);
+    out << "  csv: " << report.csv_path << " (" << csv.rows << " rows)\n";
+  }
+  out.flush();
+  return report;
+}
+
+}  // namespace rigctl

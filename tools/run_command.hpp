@@ -1,0 +1,35 @@
+// `rigctl run`: load a config, assemble the rig, run the loop with telemetry
+// and a run log, report.
+#pragma once
+
+#include <atomic>
+#include <optional>
+#include <ostream>
+#include <string>
+
+#include "rt/rig_loop.hpp"
+
+namespace rigctl {
+
+struct RunOptions {
+  std::string config_path;
+  std::optional<double> duration_s;  // default: the profile's length
+  bool fast = false;                 // simulated plant only: no pacing
+  std::string log_path;              // default: <log_dir>/<rig>-<time>.lcm
+  std::string csv_path;              // optional run-file CSV
+  std::string lcm_url;               // overrides telemetry.lcm_url
+  bool realtime = true;              // false: skip mlockall/SCHED_FIFO (tests)
+};
+
+struct RunReport {
+  LoopResult loop;
+  std::string log_path;
+  std::string csv_path;
+  double wall_s = 0.0;
+};
+
+// Throws ConfigError or std::runtime_error with a clear message; `stop`
+// ends the run early (signal handlers set it).
+RunReport run_rig(const RunOptions& options, const std::atomic<bool>& stop, std::ostream& out);
+
+}  // namespace rigctl

@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# Installs what rigctl needs from Debian's packages (only what is missing) and
+# builds it. Run as root on a fresh Debian 12 machine, or as a user with the
+# packages already present.
+#   tools/setup.sh [--plots] [--java]
+#     --plots  also python3-matplotlib/numpy for tools/plot_run.py
+#     --java   also a JDK, lcm.jar and jchart2d for tools/lcm-spy
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+
+packages=(cmake g++ make pkg-config liblcm-dev liblcm-bin libglib2.0-dev libmodbus-dev libspdlog-dev
+          libfmt-dev libeigen3-dev libgtest-dev libgmock-dev libsocketcan-dev libyaml-cpp-dev libcli11-dev
+          iproute2)
+for arg in "$@"; do
+  case "$arg" in
+    --plots) packages+=(python3 python3-numpy python3-matplotlib) ;;
+    --java) packages+=(default-jdk-headless liblcm-java libjchart2d-java) ;;
+    *) echo "setup.sh: unknown option $arg" >&2; exit 2 ;;
+  esac
+done
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup: installing ${missing[*]}"
+  if [ "$(id -u)" -ne 0 ]; then
+    echo "setup: these Debian packages are missing and installing them needs root: ${missing[*]}" >&2
+    exit 1
+  fi
+  apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+cmake -S "$root" -B "$root/build" -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
+cmake --build "$root/build" -j"$(nproc)"
