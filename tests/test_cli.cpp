@@ -1,0 +1,150 @@
+// The rigctl program end to end: subcommands, exit codes, clear errors, and
+// the guarantee that --fast gives the same log as a paced run.
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include "process.hpp"
+#include "rigctl/command_t.hpp"
+#include "rigctl/controller_t.hpp"
+#include "rigctl/sample_t.hpp"
+
+using rigctl::test::run_command;
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string kRigctl = RIGCTL_BINARY;
+const std::string kConfig = std::string(RIGCTL_SOURCE_DIR) + "/config/quarter_car.yaml";
+
+class CliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("rigctl_cli_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  fs::path dir_;
+};
+
+std::string read_file(const std::string& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// The log's data messages with their wall-clock utime cleared, re-encoded:
+// what must agree between two runs of the same config and seed.
+template <typename Msg>
+void append_normalised(const lcm::LogEvent& e, std::vector<std::string>& out) {
+  Msg m;
+  if (m.decode(e.data, 0, e.datalen) < 0) throw std::runtime_error("cannot decode " + e.channel);
+  m.utime = 0;
+  std::string bytes(static_cast<std::size_t>(m.getEncodedSize()), '\0');
+  m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  out.push_back(e.channel + ":" + bytes);
+}
+
+std::vector<std::string> data_messages(const std::string& log_path) {
+  lcm::LogFile log(log_path, "r");
+  EXPECT_TRUE(log.good()) << log_path;
+  std::vector<std::string> out;
+  while (const lcm::LogEvent* e = log.readNextEvent()) {
+    if (e->channel == "RIGCTL_SAMPLE") append_normalised<rigctl::sample_t>(*e, out);
+    if (e->channel == "RIGCTL_COMMAND") append_normalised<rigctl::command_t>(*e, out);
+    if (e->channel == "RIGCTL_CONTROLLER") append_normalised<rigctl::controller_t>(*e, out);
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST_F(CliTest, HelpListsTheSubcommands) {
+  const auto r = run_command(kRigctl + " --help");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_NE(r.output.find("run"), std::string::npos);
+  EXPECT_NE(r.output.find("log2csv"), std::string::npos);
+  EXPECT_NE(run_command(kRigctl).exit_code, 0) << "a subcommand is required";
+}
+
+TEST_F(CliTest, FastAndPacedRunsGiveIdenticalLogs) {
+  const auto paced = run_command(kRigctl + " run " + kConfig + " --duration 0.5 --log " + path("paced.lcm"));
+  ASSERT_EQ(paced.exit_code, 0) << paced.output;
+  const auto fast = run_command(kRigctl + " run " + kConfig + " --duration 0.5 --fast --log " + path("fast.lcm"));
+  ASSERT_EQ(fast.exit_code, 0) << fast.output;
+  const auto a = data_messages(path("paced.lcm"));
+  const auto b = data_messages(path("fast.lcm"));
+  EXPECT_EQ(a.size(), 3u * 200u);  // 0.5 s at 400 Hz, three data channels
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) ASSERT_EQ(a[i], b[i]) << "message " << i << " differs";
+  // A different seed changes the sensor noise: the comparison can fail.
+  std::string other = read_file(kConfig);
+  other = std::regex_replace(other, std::regex("seed: 1"), "seed: 2");
+  std::ofstream(path("seed2.yaml")) << other;
+  const auto seeded = run_command(kRigctl + " run " + path("seed2.yaml") + " --duration 0.5 --fast --log " + path("s2.lcm"));
+  ASSERT_EQ(seeded.exit_code, 0) << seeded.output;
+  EXPECT_NE(data_messages(path("s2.lcm")), a);
+}
+
+TEST_F(CliTest, RunWithoutLogWritesIntoTheRunsFolderAndSaysWhere) {
+  std::string text = read_file(kConfig);
+  text = std::regex_replace(text, std::regex("log_dir: runs"), "log_dir: " + path("runs"));
+  std::ofstream(path("rig.yaml")) << text;
+  const auto r = run_command(kRigctl + " run " + path("rig.yaml") + " --duration 0.2 --fast");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(r.output, m, std::regex("log: (\\S+\\.lcm)"))) << r.output;
+  EXPECT_TRUE(fs::exists(m[1].str())) << m[1].str();
+  EXPECT_EQ(fs::path(m[1].str()).parent_path(), fs::path(path("runs")));
+}
+
+TEST_F(CliTest, BadConfigIsAClearErrorAndNothingRuns) {
+  std::string text = read_file(kConfig);
+  text = std::regex_replace(text, std::regex("  ki: 60.0"), "  ki: lots");
+  std::ofstream(path("bad.yaml")) << text;
+  const auto r = run_command(kRigctl + " run " + path("bad.yaml") + " --fast --log " + path("x.lcm"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("bad.yaml"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("controller.ki"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(path("x.lcm"))) << "the rig must not start";
+}
+
+TEST_F(CliTest, LimitTripMakesTheRigSafeAndSaysWhy) {
+  // A stroke limit inside the ramp's travel: the run must stop faulted there.
+  std::string text = read_file(kConfig);
+  text = std::regex_replace(text, std::regex("x_r: \\[-0.012, 0.172\\]"), "x_r: [-0.012, 0.05]");
+  std::ofstream(path("limit.yaml")) << text;
+  const auto r = run_command(kRigctl + " run " + path("limit.yaml") + " --fast --log " + path("l.lcm") + " --csv " +
+                             path("l.csv"));
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("faulted (limit_tripped: x_r = 0.05"), std::string::npos) << r.output;
+  // The log is complete up to the trip and converts.
+  EXPECT_TRUE(fs::exists(path("l.csv"))) << r.output;
+}
+
+TEST_F(CliTest, Log2CsvWritesTheRunFile) {
+  ASSERT_EQ(run_command(kRigctl + " run " + kConfig + " --duration 1 --fast --log " + path("r.lcm")).exit_code, 0);
+  const auto r = run_command(kRigctl + " log2csv " + path("r.lcm") + " " + path("r.csv"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream in(path("r.csv"));
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "# rig: quarter_car");
+  while (std::getline(in, line) && line.rfind("#", 0) == 0) {
+  }
+  EXPECT_EQ(line.rfind("t,x_ref,u,x_r,x_w,x_b,v_w,v_b,p1,p2,f_t", 0), 0u) << line;
+  int rows = 0;
+  while (std::getline(in, line)) ++rows;
+  EXPECT_EQ(rows, 400);
+  const auto missing = run_command(kRigctl + " log2csv " + path("none.lcm") + " " + path("n.csv"));
+  EXPECT_NE(missing.exit_code, 0);
+  EXPECT_NE(missing.output.find("none.lcm"), std::string::npos) << missing.output;
+}
