@@ -20,7 +20,8 @@ std::string error_text(int err) { return std::string(std::strerror(err)); }
 void prefault_stack() {
   constexpr std::size_t kBytes = 256 * 1024;
   volatile unsigned char buffer[kBytes];
-  for (std::size_t i = 0; i < kBytes; i += 4096) buffer[i] = 0;
+  for (std::size_t i = 0; i < kBytes; i += 4096) buffer[i] = static_cast<unsigned char>(i);
+  (void)buffer[0];
 }
 }  // namespace
 

@@ -32,20 +32,6 @@ using Clock = std::chrono::steady_clock;
 constexpr auto kLogFlushInterval = std::chrono::seconds(1);
 constexpr auto kIdleSleep = std::chrono::milliseconds(1);
 
-std::string_view event_name(EventCode code) {
-  switch (code) {
-    case EventCode::kNone: return "";
-    case EventCode::kRunStarted: return "run_started";
-    case EventCode::kProfileFinished: return "profile_finished";
-    case EventCode::kStopRequested: return "stop_requested";
-    case EventCode::kLimitTripped: return "limit_tripped";
-    case EventCode::kInputInvalid: return "input_invalid";
-    case EventCode::kDriverReadFailed: return "driver_read_failed";
-    case EventCode::kQueueOverflow: return "queue_overflow";
-  }
-  return "unknown";
-}
-
 std::string format_g(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.6g", v);
@@ -112,6 +98,17 @@ void emit(lcm::LCM& lcm, lcm::LogFile* log, const std::string& channel, int64_t 
 TelemetryPublisher::TelemetryPublisher(TelemetryMeta meta, const std::string& lcm_url,
                                        const std::string& log_path, std::size_t queue_capacity)
     : meta_(std::move(meta)), channels_(meta_.channel_prefix), queue_(queue_capacity) {
+  // The record has fixed-size arrays: refuse a layout that would be cut short
+  // in the messages rather than silently drop channels.
+  auto check_size = [](std::size_t n, std::size_t max, const char* what) {
+    if (n > max) {
+      throw std::runtime_error("telemetry: " + std::to_string(n) + " " + what + ", at most " + std::to_string(max) +
+                               " fit in a telemetry record");
+    }
+  };
+  check_size(meta_.layout.inputs.size(), kMaxInputs, "inputs");
+  check_size(meta_.layout.outputs.size(), kMaxOutputs, "outputs");
+  check_size(meta_.term_names.size(), kMaxControllerTerms, "controller terms");
   // An empty URL would make LCM fall back to its default multicast group:
   // never do that by accident.
   if (lcm_url.empty()) throw std::runtime_error("telemetry: no LCM URL given (e.g. memq:// or udpm://...)");
@@ -181,53 +178,56 @@ void TelemetryPublisher::publish_record(const TelemetryRecord& r) {
   lcm::LogFile* log = log_.get();
   const ChannelLayout& layout = meta_.layout;
 
-  rigctl::sample_t s;
-  s.utime = utime;
-  s.tick = r.tick;
-  s.t = t;
-  s.rig = meta_.rig;
-  s.status = static_cast<int32_t>(r.sample.status);
-  const std::size_t n_in = std::min(layout.inputs.size(), kMaxInputs);
-  s.num_channels = static_cast<int16_t>(n_in);
-  for (std::size_t i = 0; i < n_in; ++i) {
-    s.names.push_back(layout.inputs[i].name);
-    s.units.push_back(layout.inputs[i].unit);
-    s.values.push_back(r.sample.value[i]);
-  }
-  emit(*lcm_, log, channels_.sample, utime, s);
+  // The closing record of a run carries no tick of data (see has_sample).
+  if (r.has_sample) {
+    rigctl::sample_t s;
+    s.utime = utime;
+    s.tick = r.tick;
+    s.t = t;
+    s.rig = meta_.rig;
+    s.status = static_cast<int32_t>(r.sample.status);
+    const std::size_t n_in = std::min(layout.inputs.size(), kMaxInputs);
+    s.num_channels = static_cast<int16_t>(n_in);
+    for (std::size_t i = 0; i < n_in; ++i) {
+      s.names.push_back(layout.inputs[i].name);
+      s.units.push_back(layout.inputs[i].unit);
+      s.values.push_back(r.sample.value[i]);
+    }
+    emit(*lcm_, log, channels_.sample, utime, s);
 
-  rigctl::command_t c;
-  c.utime = utime;
-  c.tick = r.tick;
-  c.t = t;
-  c.setpoint_name = meta_.setpoint_name;
-  c.setpoint = r.controller.setpoint;
-  const std::size_t n_out = std::min(layout.outputs.size(), kMaxOutputs);
-  c.num_outputs = static_cast<int16_t>(n_out);
-  for (std::size_t i = 0; i < n_out; ++i) {
-    c.names.push_back(layout.outputs[i].name);
-    c.units.push_back(layout.outputs[i].unit);
-    c.values.push_back(r.command.value[i]);
-  }
-  emit(*lcm_, log, channels_.command, utime, c);
+    rigctl::command_t c;
+    c.utime = utime;
+    c.tick = r.tick;
+    c.t = t;
+    c.setpoint_name = meta_.setpoint_name;
+    c.setpoint = r.controller.setpoint;
+    const std::size_t n_out = std::min(layout.outputs.size(), kMaxOutputs);
+    c.num_outputs = static_cast<int16_t>(n_out);
+    for (std::size_t i = 0; i < n_out; ++i) {
+      c.names.push_back(layout.outputs[i].name);
+      c.units.push_back(layout.outputs[i].unit);
+      c.values.push_back(r.command.value[i]);
+    }
+    emit(*lcm_, log, channels_.command, utime, c);
 
-  rigctl::controller_t k;
-  k.utime = utime;
-  k.tick = r.tick;
-  k.t = t;
-  k.controller = meta_.controller_name;
-  k.setpoint = r.controller.setpoint;
-  k.measurement = r.controller.measurement;
-  k.error = r.controller.error;
-  const std::size_t n_terms = std::min(meta_.term_names.size(), kMaxControllerTerms);
-  k.num_terms = static_cast<int16_t>(n_terms);
-  k.term_names.assign(meta_.term_names.begin(), meta_.term_names.begin() + n_terms);
-  k.terms.assign(r.controller.term.begin(), r.controller.term.begin() + n_terms);
-  k.output_unsaturated = r.controller.output_unsaturated;
-  k.output = r.controller.output;
-  k.saturated = r.controller.saturated;
-  k.integrator_held = r.controller.integrator_held;
-  emit(*lcm_, log, channels_.controller, utime, k);
+    rigctl::controller_t k;
+    k.utime = utime;
+    k.tick = r.tick;
+    k.t = t;
+    k.controller = meta_.controller_name;
+    k.setpoint = r.controller.setpoint;
+    k.measurement = r.controller.measurement;
+    k.error = r.controller.error;
+    const std::size_t n_terms = std::min(meta_.term_names.size(), kMaxControllerTerms);
+    k.num_terms = static_cast<int16_t>(n_terms);
+    k.term_names.assign(meta_.term_names.begin(), meta_.term_names.begin() + n_terms);
+    k.terms.assign(r.controller.term.begin(), r.controller.term.begin() + n_terms);
+    k.output_unsaturated = r.controller.output_unsaturated;
+    k.output = r.controller.output;
+    k.saturated = r.controller.saturated;
+    k.integrator_held = r.controller.integrator_held;
+    emit(*lcm_, log, channels_.controller, utime, k);
+  }
 
   if (first_record_ || r.state != last_state_ || r.event.code != EventCode::kNone) {
     rigctl::state_t st;
@@ -235,7 +235,7 @@ void TelemetryPublisher::publish_record(const TelemetryRecord& r) {
     st.tick = r.tick;
     st.t = t;
     st.state = std::string(to_string(r.state));
-    st.event = std::string(event_name(r.event.code));
+    st.event = std::string(to_string(r.event.code));
     st.message = event_message(r.event, layout);
     emit(*lcm_, log, channels_.state, utime, st);
     first_record_ = false;

@@ -3,7 +3,14 @@
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
 #include <filesystem>
+#include <thread>
 #include <fstream>
 #include <regex>
 #include <sstream>
@@ -147,4 +154,38 @@ TEST_F(CliTest, Log2CsvWritesTheRunFile) {
   const auto missing = run_command(kRigctl + " log2csv " + path("none.lcm") + " " + path("n.csv"));
   EXPECT_NE(missing.exit_code, 0);
   EXPECT_NE(missing.output.find("none.lcm"), std::string::npos) << missing.output;
+}
+
+TEST_F(CliTest, SigintStopsThePacedRunCleanlyAndKeepsTheLog) {
+  const std::string out_path = path("out.txt");
+  const std::string log_path = path("sig.lcm");
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    const int fd = ::open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    dup2(fd, 1);
+    dup2(fd, 2);
+    execl(kRigctl.c_str(), kRigctl.c_str(), "run", kConfig.c_str(), "--duration", "30", "--log", log_path.c_str(),
+          static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(800));
+  ASSERT_EQ(kill(pid, SIGINT), 0);
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  const std::string output = read_file(out_path);
+  ASSERT_TRUE(WIFEXITED(status)) << output;
+  EXPECT_EQ(WEXITSTATUS(status), 0) << output;
+  EXPECT_NE(output.find("stopped (stop_requested)"), std::string::npos) << output;
+  // The log holds what ran, closed properly: it converts, and its last
+  // state message says why the run ended.
+  const auto rows = data_messages(log_path).size() / 3;
+  EXPECT_GT(rows, 40u);
+  EXPECT_LT(rows, 30u * 400u);
+  lcm::LogFile log(log_path, "r");
+  std::string last_state;
+  while (const lcm::LogEvent* e = log.readNextEvent()) {
+    if (e->channel == "RIGCTL_STATE") last_state.assign(static_cast<const char*>(e->data), e->datalen);
+  }
+  EXPECT_NE(last_state.find("stop_requested"), std::string::npos);
 }

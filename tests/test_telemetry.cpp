@@ -299,7 +299,7 @@ TEST_F(TelemetryTest, LogIsFlushedWhileRunning) {
   pub.stop();
 }
 
-TEST_F(TelemetryTest, BadUrlOrLogPathThrowsNamingIt) {
+TEST_F(TelemetryTest, BadUrlLogPathOrLayoutThrows) {
   try {
     TelemetryPublisher pub(make_meta(), "nosuchprovider://x", "");
     FAIL() << "no exception for a bad URL";
@@ -307,6 +307,10 @@ TEST_F(TelemetryTest, BadUrlOrLogPathThrowsNamingIt) {
     EXPECT_NE(std::string(e.what()).find("nosuchprovider://x"), std::string::npos) << e.what();
   }
   EXPECT_THROW(TelemetryPublisher(make_meta(), "", ""), std::runtime_error);
+
+  TelemetryMeta too_wide = make_meta();
+  too_wide.layout.inputs.resize(kMaxInputs + 1, {"extra", "m"});
+  EXPECT_THROW(TelemetryPublisher(too_wide, "memq://", ""), std::runtime_error);
 
   fs::create_directories(dir_);
   std::ofstream(dir_ / "plainfile") << "x";
