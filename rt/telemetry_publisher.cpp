@@ -155,6 +155,11 @@ void TelemetryPublisher::stop() {
 
 lcm::LCM& TelemetryPublisher::lcm() { return *lcm_; }
 
+std::optional<TelemetryRecord> TelemetryPublisher::latest() const {
+  std::lock_guard<std::mutex> lock(latest_mutex_);
+  return latest_;
+}
+
 void TelemetryPublisher::thread_main() {
   auto last_flush = Clock::now();
   TelemetryRecord record;
@@ -180,6 +185,10 @@ void TelemetryPublisher::publish_record(const TelemetryRecord& r) {
 
   // The closing record of a run carries no tick of data (see has_sample).
   if (r.has_sample) {
+    {
+      std::lock_guard<std::mutex> lock(latest_mutex_);
+      latest_ = r;
+    }
     rigctl::sample_t s;
     s.utime = utime;
     s.tick = r.tick;

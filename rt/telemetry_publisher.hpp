@@ -6,6 +6,8 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -69,6 +71,9 @@ class TelemetryPublisher final : public TelemetrySink {
   const TelemetryChannels& channels() const { return channels_; }
   // The LCM instance, so in-process subscribers (memq://) can share it.
   lcm::LCM& lcm();
+  // The newest record published, for a console status line. Shared with the
+  // publisher thread under a mutex; the real-time loop never touches it.
+  std::optional<TelemetryRecord> latest() const;
 
  private:
   void thread_main();
@@ -83,6 +88,8 @@ class TelemetryPublisher final : public TelemetrySink {
   std::atomic<bool> running_{false};
   std::atomic<int64_t> published_{0};
   std::atomic<int64_t> dropped_{0};
+  mutable std::mutex latest_mutex_;
+  std::optional<TelemetryRecord> latest_;
   RigState last_state_ = RigState::kStarting;
   bool first_record_ = true;
 };

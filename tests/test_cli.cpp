@@ -189,3 +189,23 @@ TEST_F(CliTest, SigintStopsThePacedRunCleanlyAndKeepsTheLog) {
   }
   EXPECT_NE(last_state.find("stop_requested"), std::string::npos);
 }
+
+TEST_F(CliTest, RunLogIsReadByLcmLogplayer) {
+  ASSERT_EQ(run_command(kRigctl + " run " + kConfig + " --duration 0.05 --fast --log " + path("p.lcm")).exit_code, 0);
+  int events = 0;
+  {
+    lcm::LogFile log(path("p.lcm"), "r");
+    while (log.readNextEvent() != nullptr) ++events;
+  }
+  // LCM's own player, replaying in-process only (memq://), 1000x speed.
+  const auto r = run_command("lcm-logplayer -v --lcm-url=memq:// -s 1000 " + path("p.lcm"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  int played = 0, samples = 0;
+  std::istringstream lines(r.output);
+  for (std::string line; std::getline(lines, line);) {
+    played += line.find(" Channel ") != std::string::npos;
+    samples += line.find("Channel RIGCTL_SAMPLE ") != std::string::npos;
+  }
+  EXPECT_EQ(played, events);
+  EXPECT_EQ(samples, 20);  // 0.05 s at 400 Hz
+}

@@ -13,6 +13,7 @@
 #include "config/rig_config.hpp"
 #include "rt/realtime.hpp"
 #include "rt/telemetry_publisher.hpp"
+#include "tools/console_status.hpp"
 #include "tools/log2csv.hpp"
 #include "tools/rig_assembly.hpp"
 
@@ -106,6 +107,10 @@ RunReport run_rig(const RunOptions& options, const std::atomic<bool>& stop, std:
     if (!options.fast) {
       session.emplace(rt);
       for (const auto& w : session->warnings()) spdlog::warn("{}", w);
+    }
+    std::optional<ConsoleStatus> status;
+    if (!options.fast) {
+      status.emplace(publisher, meta, rig.driver->layout().input_index(config.controller.feedback), duration, out);
     }
     RigLoop loop(*rig.driver, *rig.controller, *rig.profile, rig.limits, publisher, clock, loop_options);
     try {
