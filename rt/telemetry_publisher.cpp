@@ -65,6 +65,19 @@ std::string event_message(const Event& ev, const ChannelLayout& layout) {
   return "unknown event";
 }
 
+// Names, units and values of a layout's channels into a message's arrays;
+// returns the count. The constructor made sure the layout fits the record.
+template <std::size_t N>
+int16_t fill_channels(const std::vector<ChannelInfo>& channels, const std::array<double, N>& values,
+                      std::vector<std::string>& names, std::vector<std::string>& units, std::vector<double>& out) {
+  for (std::size_t i = 0; i < channels.size(); ++i) {
+    names.push_back(channels[i].name);
+    units.push_back(channels[i].unit);
+    out.push_back(values[i]);
+  }
+  return static_cast<int16_t>(channels.size());
+}
+
 // The one place a message is encoded, published and logged, so that the log
 // holds exactly the bytes that went onto the bus.
 template <typename Msg>
@@ -195,13 +208,7 @@ void TelemetryPublisher::publish_record(const TelemetryRecord& r) {
     s.t = t;
     s.rig = meta_.rig;
     s.status = static_cast<int32_t>(r.sample.status);
-    const std::size_t n_in = std::min(layout.inputs.size(), kMaxInputs);
-    s.num_channels = static_cast<int16_t>(n_in);
-    for (std::size_t i = 0; i < n_in; ++i) {
-      s.names.push_back(layout.inputs[i].name);
-      s.units.push_back(layout.inputs[i].unit);
-      s.values.push_back(r.sample.value[i]);
-    }
+    s.num_channels = fill_channels(layout.inputs, r.sample.value, s.names, s.units, s.values);
     emit(*lcm_, log, channels_.sample, utime, s);
 
     rigctl::command_t c;
@@ -210,13 +217,7 @@ void TelemetryPublisher::publish_record(const TelemetryRecord& r) {
     c.t = t;
     c.setpoint_name = meta_.setpoint_name;
     c.setpoint = r.controller.setpoint;
-    const std::size_t n_out = std::min(layout.outputs.size(), kMaxOutputs);
-    c.num_outputs = static_cast<int16_t>(n_out);
-    for (std::size_t i = 0; i < n_out; ++i) {
-      c.names.push_back(layout.outputs[i].name);
-      c.units.push_back(layout.outputs[i].unit);
-      c.values.push_back(r.command.value[i]);
-    }
+    c.num_outputs = fill_channels(layout.outputs, r.command.value, c.names, c.units, c.values);
     emit(*lcm_, log, channels_.command, utime, c);
 
     rigctl::controller_t k;
