@@ -33,28 +33,79 @@ ConfigReader::ConfigReader(YAML::Node node, std::shared_ptr<const std::string> f
     : node_(std::move(node)), file_(std::move(file)), path_(std::move(path)),
       used_(std::make_shared<std::set<std::string>>()) {}
 
-ConfigReader ConfigReader::load(const std::string& path) {
-  YAML::Node root;
+namespace {
+void merge_into(YAML::Node target, const YAML::Node& overlay) {
+  for (const auto& kv : overlay) {
+    const auto key = kv.first.as<std::string>();
+    YAML::Node existing = target[key];
+    if (kv.second.IsMap() && existing.IsMap()) {
+      merge_into(existing, kv.second);
+    } else {
+      target[key] = YAML::Clone(kv.second);
+    }
+  }
+}
+
+YAML::Node load_file(const std::string& path) {
   try {
-    root = YAML::LoadFile(path);
+    return YAML::LoadFile(path);
   } catch (const YAML::BadFile&) {
     throw ConfigError(path + ": cannot open config file");
   } catch (const YAML::Exception& e) {
     throw ConfigError(path + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
   }
-  if (!root.IsMap()) throw ConfigError(path + ": config must be a mapping of keys to values");
-  return ConfigReader(root, std::make_shared<const std::string>(path), "");
+}
+}  // namespace
+
+ConfigReader ConfigReader::from_root(YAML::Node root, const std::string& name, const std::string& case_name) {
+  if (!root.IsMap()) throw ConfigError(name + ": config must be a mapping of keys to values");
+  const YAML::Node cases = root["cases"];
+  if (cases.IsDefined() && !cases.IsMap()) {
+    throw ConfigError(name + ":" + std::to_string(cases.Mark().line + 1) + ": cases: expected a mapping of case names");
+  }
+  if (!case_name.empty()) {
+    if (!cases.IsDefined() || !cases[case_name].IsDefined()) {
+      std::string known;
+      if (cases.IsDefined()) {
+        for (const auto& kv : cases) known += (known.empty() ? "" : ", ") + kv.first.as<std::string>();
+      }
+      throw ConfigError(name + ": cases: no case '" + case_name + "'" +
+                        (known.empty() ? " (the file defines none)" : " (cases: " + known + ")"));
+    }
+    const YAML::Node chosen = YAML::Clone(cases[case_name]);
+    if (!chosen.IsMap()) {
+      throw ConfigError(name + ":" + std::to_string(chosen.Mark().line + 1) + ": cases." + case_name +
+                        ": expected a mapping of keys to override");
+    }
+    root.remove("cases");
+    merge_into(root, chosen);
+  } else {
+    root.remove("cases");
+  }
+  return ConfigReader(root, std::make_shared<const std::string>(name), "");
 }
 
-ConfigReader ConfigReader::from_string(const std::string& text, const std::string& name) {
+ConfigReader ConfigReader::load(const std::string& path, const std::string& case_name) {
+  return from_root(load_file(path), path, case_name);
+}
+
+ConfigReader ConfigReader::from_string(const std::string& text, const std::string& name, const std::string& case_name) {
   YAML::Node root;
   try {
     root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     throw ConfigError(name + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
   }
-  if (!root.IsMap()) throw ConfigError(name + ": config must be a mapping of keys to values");
-  return ConfigReader(root, std::make_shared<const std::string>(name), "");
+  return from_root(root, name, case_name);
+}
+
+std::vector<std::string> ConfigReader::case_names(const std::string& path) {
+  const YAML::Node root = load_file(path);
+  std::vector<std::string> names;
+  if (root.IsMap() && root["cases"].IsMap()) {
+    for (const auto& kv : root["cases"]) names.push_back(kv.first.as<std::string>());
+  }
+  return names;
 }
 
 std::string ConfigReader::path_of(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }

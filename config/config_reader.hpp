@@ -21,9 +21,14 @@ class ConfigError : public std::runtime_error {
 
 class ConfigReader {
  public:
-  // Loads the file; throws ConfigError on I/O or YAML syntax errors.
-  static ConfigReader load(const std::string& path);
-  static ConfigReader from_string(const std::string& text, const std::string& name);
+  // Loads the file; throws ConfigError on I/O or YAML syntax errors. A
+  // top-level `cases:` map holds named variants; case_name picks one and
+  // merges it over the rest (mappings key by key, other values replaced).
+  static ConfigReader load(const std::string& path, const std::string& case_name = "");
+  static ConfigReader from_string(const std::string& text, const std::string& name,
+                                  const std::string& case_name = "");
+  // Names of the variants under `cases:` (empty when there are none).
+  static std::vector<std::string> case_names(const std::string& path);
 
   bool has(const std::string& key) const;
 
@@ -51,6 +56,7 @@ class ConfigReader {
 
  private:
   ConfigReader(YAML::Node node, std::shared_ptr<const std::string> file, std::string path);
+  static ConfigReader from_root(YAML::Node root, const std::string& name, const std::string& case_name);
   YAML::Node required(const std::string& key);
   [[noreturn]] void fail_at(const YAML::Node& node, const std::string& key, const std::string& reason) const;
 

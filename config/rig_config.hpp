@@ -8,8 +8,10 @@
 #include <vector>
 
 #include "drivers/sensor_model.hpp"
+#include "plant/pneumatic_rotary_params.hpp"
 #include "plant/quarter_car_params.hpp"
 #include "rt/pi_controller.hpp"
+#include "rt/pvp_controller.hpp"
 #include "rt/realtime.hpp"
 #include "rt/timing_stats.hpp"
 
@@ -17,7 +19,7 @@ namespace rigctl {
 
 // Rig kinds this build knows; others are a config error naming the list.
 inline const std::vector<std::string>& known_rig_kinds() {
-  static const std::vector<std::string> kinds{"quarter_car"};
+  static const std::vector<std::string> kinds{"quarter_car", "pneumatic_rotary"};
   return kinds;
 }
 
@@ -35,16 +37,18 @@ struct TelemetryConfig {
 };
 
 struct ControllerConfig {
-  std::string type = "pi";
-  std::string feedback;  // input channel name
-  std::string output;    // output channel name
-  PiConfig pi;           // channel indices resolved when the rig is assembled
+  std::string type = "pi";  // pi (quarter_car) | pvp (pneumatic_rotary)
+  std::string feedback;     // input channel name
+  std::string output;       // output channel name
+  PiConfig pi;              // type pi; channel indices resolved when the rig is assembled
+  PvpConfig pvp;            // type pvp
+  std::string pressure;     // type pvp: differential-pressure input channel
 };
 
 struct ProfileConfig {
   std::string type = "ramp_steps";  // ramp_steps | sine | csv
   double filter_tau_s = 0.0;
-  // ramp_steps and sine
+  // ramp_steps and sine; positions in the feedback channel's unit (m or rad)
   double start = 0.0, hold_s = 0.0, ramp_target = 0.0, ramp_rate = 0.0;
   std::vector<double> steps;  // ramp_steps
   double step_hold_s = 0.0;
@@ -60,6 +64,7 @@ struct LimitConfig {
 
 struct RigConfig {
   std::string file;
+  std::string case_name;  // the `cases:` entry applied, "" for none
   std::string rig;
   std::string driver = "sim";
   uint64_t seed = 1;
@@ -68,12 +73,18 @@ struct RigConfig {
   ControllerConfig controller;
   ProfileConfig profile;
   std::vector<LimitConfig> limits;
-  QuarterCarParams quarter_car;
+  QuarterCarParams quarter_car;          // rig quarter_car
+  PneumaticRotaryParams pneumatic_rotary;  // rig pneumatic_rotary
   std::map<std::string, SensorSpec> sensors;  // by channel name
+  std::map<std::string, SensorSpec> dacs;     // output converters, by output name (noise unused)
 };
 
-// Throws ConfigError naming file, line, key and reason.
-RigConfig load_rig_config(const std::string& path);
-RigConfig parse_rig_config(const std::string& yaml_text, const std::string& name);
+// Throws ConfigError naming file, line, key and reason. case_name selects an
+// entry of the file's optional `cases:` map, merged over the rest (the
+// paper's ready-made variants); "" uses the file as it is.
+RigConfig load_rig_config(const std::string& path, const std::string& case_name = "");
+RigConfig parse_rig_config(const std::string& yaml_text, const std::string& name, const std::string& case_name = "");
+// Names of the `cases:` entries of a config file.
+std::vector<std::string> config_case_names(const std::string& path);
 
 }  // namespace rigctl

@@ -5,8 +5,8 @@
 
 namespace rigctl {
 
-SimDriver::SimDriver(std::unique_ptr<SimulatedPlant> plant, std::vector<SensorSpec> sensors, double period_s,
-                     uint64_t seed, std::vector<double> safe_command)
+SimDriver::SimDriver(std::unique_ptr<SimulatedPlant> plant, std::vector<SensorSpec> sensors,
+                     std::vector<SensorSpec> dacs, double period_s, uint64_t seed, std::vector<double> safe_command)
     : plant_(std::move(plant)), period_s_(period_s), period_ns_(static_cast<int64_t>(period_s * 1e9 + 0.5)), seed_(seed), safe_command_(std::move(safe_command)) {
   layout_.inputs = plant_->signals();
   layout_.outputs = plant_->commands();
@@ -14,7 +14,12 @@ SimDriver::SimDriver(std::unique_ptr<SimulatedPlant> plant, std::vector<SensorSp
   if (layout_.outputs.size() > kMaxOutputs) throw std::invalid_argument("plant has more commands than a Command holds");
   if (sensors.size() != layout_.inputs.size()) throw std::invalid_argument("one sensor spec per plant signal is needed");
   if (safe_command_.size() != layout_.outputs.size()) throw std::invalid_argument("safe command size differs from outputs");
+  if (dacs.size() != layout_.outputs.size()) throw std::invalid_argument("one DAC spec per plant command is needed");
   for (const auto& s : sensors) sensors_.emplace_back(s);
+  for (auto d : dacs) {
+    d.noise_sd = 0.0;  // a DAC quantises and clips; its noise belongs to the plant
+    dacs_.emplace_back(d);
+  }
   command_ = safe_command_;
   truth_.assign(layout_.inputs.size(), 0.0);
 }
@@ -43,7 +48,7 @@ bool SimDriver::read(Sample& out) {
 }
 
 void SimDriver::write(const Command& command) {
-  for (std::size_t i = 0; i < command_.size(); ++i) command_[i] = command.value[i];
+  for (std::size_t i = 0; i < command_.size(); ++i) command_[i] = dacs_[i].measure(command.value[i], rng_);
 }
 
 void SimDriver::make_safe() noexcept { std::copy(safe_command_.begin(), safe_command_.end(), command_.begin()); }

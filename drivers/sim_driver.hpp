@@ -17,9 +17,11 @@ namespace rigctl {
 class SimDriver final : public Driver {
  public:
   // sensors: one per plant signal, in signals() order (truth channels usually
-  // get a default, noise-free SensorSpec). safe_command: outputs on make_safe.
-  SimDriver(std::unique_ptr<SimulatedPlant> plant, std::vector<SensorSpec> sensors, double period_s,
-            uint64_t seed, std::vector<double> safe_command);
+  // get a default, noise-free SensorSpec). dacs: one per plant command, the
+  // output converter's range and resolution (noise ignored). safe_command:
+  // outputs on make_safe.
+  SimDriver(std::unique_ptr<SimulatedPlant> plant, std::vector<SensorSpec> sensors, std::vector<SensorSpec> dacs,
+            double period_s, uint64_t seed, std::vector<double> safe_command);
 
   const ChannelLayout& layout() const override { return layout_; }
   void start() override;
@@ -34,6 +36,7 @@ class SimDriver final : public Driver {
  private:
   std::unique_ptr<SimulatedPlant> plant_;
   std::vector<SensorModel> sensors_;
+  std::vector<SensorModel> dacs_;
   ChannelLayout layout_;
   double period_s_;
   int64_t period_ns_;

@@ -116,3 +116,47 @@ TEST(RigConfig, MissingFile) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/rig.yaml"), std::string::npos);
   }
 }
+
+TEST(RigConfig, CasesMergeOverTheFileAndUnknownCasesAreNamed) {
+  const std::string yaml = shipped_config() + R"(
+cases:
+  soft: {controller: {kp: 40.0}, plant: {bearing_friction: {enabled: false}}}
+  broken: {controller: {kq: 1.0}}
+)";
+  const auto base = parse_rig_config(yaml, "c.yaml");
+  EXPECT_DOUBLE_EQ(base.controller.pi.kp, 80.0);
+  EXPECT_TRUE(base.quarter_car.bearing_friction.enabled);
+  const auto soft = parse_rig_config(yaml, "c.yaml", "soft");
+  EXPECT_DOUBLE_EQ(soft.controller.pi.kp, 40.0);
+  EXPECT_DOUBLE_EQ(soft.controller.pi.ki, 60.0) << "keys the case does not name are kept";
+  EXPECT_FALSE(soft.quarter_car.bearing_friction.enabled);
+  EXPECT_DOUBLE_EQ(soft.quarter_car.bearing_friction.coulomb_base, 40.0);
+  try {
+    parse_rig_config(yaml, "c.yaml", "hard");
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("no case 'hard' (cases: soft, broken)"), std::string::npos) << e.what();
+  }
+  try {
+    parse_rig_config(yaml, "c.yaml", "broken");
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("controller.kq: unknown key"), std::string::npos) << e.what();
+  }
+}
+
+TEST(RigConfig, PneumaticConfigAndEveryPaperCaseLoad) {
+  const std::string path = std::string(RIGCTL_SOURCE_DIR) + "/config/pneumatic_rotary.yaml";
+  const auto c = load_rig_config(path);
+  EXPECT_EQ(c.rig, "pneumatic_rotary");
+  EXPECT_EQ(c.controller.type, "pvp");
+  EXPECT_DOUBLE_EQ(c.pneumatic_rotary.hysteresis.level, 0.02);  // per cent converted
+  EXPECT_EQ(c.dacs.at("u").bits, 12);
+  const auto names = config_case_names(path);
+  EXPECT_GE(names.size(), 10u);
+  for (const auto& name : names) EXPECT_NO_THROW(load_rig_config(path, name)) << name;
+  const auto fig7 = load_rig_config(path, "fig7");
+  EXPECT_DOUBLE_EQ(fig7.controller.pvp.kp, 1.7e-5) << "V/bar converted to V/Pa";
+  const auto fig4e = load_rig_config(path, "fig4e");
+  EXPECT_DOUBLE_EQ(fig4e.pneumatic_rotary.inertia, 0.4);
+}

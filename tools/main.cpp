@@ -35,6 +35,7 @@ int main(int argc, char** argv) {
   double duration = 0.0;
   auto* run_cmd = app.add_subcommand("run", "Run the control loop on a rig (simulated by default) with LCM telemetry and a run log");
   run_cmd->add_option("config", run.config_path, "Rig config (YAML), e.g. config/quarter_car.yaml")->required()->check(CLI::ExistingFile);
+  run_cmd->add_option("--case", run.case_name, "Apply a named variant from the config's `cases:` (e.g. fig4c)");
   auto* duration_opt = run_cmd->add_option("--duration", duration, "Run length [s] (default: the profile's length)")->check(CLI::PositiveNumber);
   run_cmd->add_flag("--fast", run.fast, "Simulated plant only: run as fast as the CPU allows, same results as paced");
   run_cmd->add_option("--log", run.log_path, "LCM log file to write (default: a new file in the config's log_dir)");

@@ -4,6 +4,7 @@
 #include "drivers/sim_driver.hpp"
 #include "plant/quarter_car_plant.hpp"
 #include "rt/pi_controller.hpp"
+#include "rt/pvp_controller.hpp"
 
 namespace rigctl {
 
@@ -40,11 +41,65 @@ std::vector<SensorSpec> sensor_specs(const RigConfig& c, const std::vector<Chann
   return out;
 }
 
+std::vector<SensorSpec> dac_specs(const RigConfig& c, const std::vector<ChannelInfo>& commands) {
+  for (const auto& [name, spec] : c.dacs) {
+    bool found = false;
+    for (const auto& s : commands) found = found || s.name == name;
+    if (!found) config_fail(c, "outputs." + name, "no such output on this rig (outputs: " + channel_list(commands) + ")");
+  }
+  std::vector<SensorSpec> out;
+  for (const auto& s : commands) {
+    const auto it = c.dacs.find(s.name);
+    if (it == c.dacs.end()) config_fail(c, "outputs." + s.name, "missing required key (a converter for every output)");
+    out.push_back(it->second);
+  }
+  return out;
+}
+
+std::unique_ptr<SimulatedPlant> make_pneumatic_plant(const RigConfig& c) {
+  config_fail(c, "rig", "the pneumatic_rotary plant is not built yet");
+}
+
+std::unique_ptr<SimulatedPlant> make_plant(const RigConfig& c) {
+  if (c.rig == "quarter_car") return std::make_unique<QuarterCarPlant>(c.quarter_car);
+  return make_pneumatic_plant(c);
+}
+
 std::unique_ptr<Driver> make_driver(const RigConfig& c) {
-  auto plant = std::make_unique<QuarterCarPlant>(c.quarter_car);
+  auto plant = make_plant(c);
   auto sensors = sensor_specs(c, plant->signals());
-  std::vector<double> safe(plant->commands().size(), 0.0);  // valve to null
-  return std::make_unique<SimDriver>(std::move(plant), std::move(sensors), c.loop.period_s, c.seed, std::move(safe));
+  auto dacs = dac_specs(c, plant->commands());
+  // Both rigs' safe output is 0: valve at null (servovalve current, solenoid voltage).
+  std::vector<double> safe(plant->commands().size(), 0.0);
+  return std::make_unique<SimDriver>(std::move(plant), std::move(sensors), std::move(dacs), c.loop.period_s, c.seed,
+                                     std::move(safe));
+}
+
+int required_input(const RigConfig& c, const ChannelLayout& layout, const std::string& key, const std::string& name) {
+  const int index = layout.input_index(name);
+  if (index < 0) {
+    config_fail(c, key, "unknown input channel '" + name + "' (inputs: " + channel_list(layout.inputs) + ")");
+  }
+  return index;
+}
+
+std::unique_ptr<Controller> make_controller(const RigConfig& c, const ChannelLayout& layout) {
+  const int output = layout.output_index(c.controller.output);
+  if (output < 0) {
+    config_fail(c, "controller.output", "unknown output channel '" + c.controller.output + "' (outputs: " +
+                                             channel_list(layout.outputs) + ")");
+  }
+  if (c.controller.type == "pi") {
+    PiConfig pi = c.controller.pi;
+    pi.feedback_input = required_input(c, layout, "controller.feedback", c.controller.feedback);
+    pi.output_index = output;
+    return std::make_unique<PiController>(pi);
+  }
+  PvpConfig pvp = c.controller.pvp;
+  pvp.angle_input = required_input(c, layout, "controller.feedback", c.controller.feedback);
+  pvp.pressure_input = required_input(c, layout, "controller.pressure", c.controller.pressure);
+  pvp.output_index = output;
+  return std::make_unique<PvpController>(pvp);
 }
 
 std::unique_ptr<FilteredProfile> make_profile(const RigConfig& c, double& duration) {
@@ -70,6 +125,7 @@ std::unique_ptr<FilteredProfile> make_profile(const RigConfig& c, double& durati
 
 std::string setpoint_name_for(const std::string& rig) {
   if (rig == "quarter_car") return "x_ref";
+  if (rig == "pneumatic_rotary") return "theta_d";
   return "setpoint";
 }
 
@@ -78,18 +134,7 @@ AssembledRig assemble_rig(const RigConfig& c) {
   rig.driver = make_driver(c);
   const ChannelLayout& layout = rig.driver->layout();
 
-  PiConfig pi = c.controller.pi;
-  pi.feedback_input = layout.input_index(c.controller.feedback);
-  if (pi.feedback_input < 0) {
-    config_fail(c, "controller.feedback", "unknown input channel '" + c.controller.feedback + "' (inputs: " +
-                                               channel_list(layout.inputs) + ")");
-  }
-  pi.output_index = layout.output_index(c.controller.output);
-  if (pi.output_index < 0) {
-    config_fail(c, "controller.output", "unknown output channel '" + c.controller.output + "' (outputs: " +
-                                             channel_list(layout.outputs) + ")");
-  }
-  rig.controller = std::make_unique<PiController>(pi);
+  rig.controller = make_controller(c, layout);
 
   std::vector<InputLimit> limits;
   for (const auto& l : c.limits) {

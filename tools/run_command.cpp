@@ -50,7 +50,7 @@ std::string describe(const DistributionSummary& d) {
 }  // namespace
 
 RunReport run_rig(const RunOptions& options, const std::atomic<bool>& stop, std::ostream& out) {
-  const RigConfig config = load_rig_config(options.config_path);
+  const RigConfig config = load_rig_config(options.config_path, options.case_name);
   AssembledRig rig = assemble_rig(config);
   if (options.fast && !rig.driver->simulated()) {
     throw std::runtime_error("--fast needs a simulated driver: '" + config.driver + "' runs real hardware in real time");
@@ -87,7 +87,8 @@ RunReport run_rig(const RunOptions& options, const std::atomic<bool>& stop, std:
   rig.driver->start();
   publisher.start();  // before the real-time set-up: the publisher keeps normal priority
 
-  out << "rigctl run: " << config.rig << " (" << config.driver << " driver) from " << options.config_path << ", "
+  out << "rigctl run: " << config.rig << " (" << config.driver << " driver) from " << options.config_path
+      << (options.case_name.empty() ? "" : " case " + options.case_name) << ", "
       << duration << " s " << (options.fast ? "as fast as possible" : "paced by the real clock") << "\n"
       << "  telemetry: " << url << " channels " << config.telemetry.channel_prefix << "*\n";
   out.flush();

@@ -13,6 +13,7 @@ namespace rigctl {
 
 struct RunOptions {
   std::string config_path;
+  std::string case_name;             // a `cases:` entry of the config, "" for none
   std::optional<double> duration_s;  // default: the profile's length
   bool fast = false;                 // simulated plant only: no pacing
   std::string log_path;              // default: <log_dir>/<rig>-<time>.lcm

@@ -1,0 +1,14 @@
+// Readers of each rig kind's `plant:` section, with the unit conversions of
+// the config edge (degrees, bar, per-cent) done here.
+#pragma once
+
+#include "config/config_reader.hpp"
+#include "plant/pneumatic_rotary_params.hpp"
+#include "plant/quarter_car_params.hpp"
+
+namespace rigctl {
+
+void read_quarter_car_plant(ConfigReader r, QuarterCarParams& p);
+void read_pneumatic_rotary_plant(ConfigReader r, PneumaticRotaryParams& p);
+
+}  // namespace rigctl
