@@ -209,3 +209,23 @@ TEST_F(CliTest, RunLogIsReadByLcmLogplayer) {
   EXPECT_EQ(played, events);
   EXPECT_EQ(samples, 20);  // 0.05 s at 400 Hz
 }
+
+TEST_F(CliTest, PneumaticRigRunsEveryPaperCaseAndWritesItsRunFile) {
+  const std::string config = std::string(RIGCTL_SOURCE_DIR) + "/config/pneumatic_rotary.yaml";
+  for (const char* c : {"fig4c", "fig8", "fig10"}) {
+    const auto r = run_command(kRigctl + " run " + config + " --case " + c + " --fast --log " + path(std::string(c) + ".lcm") +
+                               " --csv " + path(std::string(c) + ".csv"));
+    ASSERT_EQ(r.exit_code, 0) << c << ": " << r.output;
+    EXPECT_NE(r.output.find(std::string("case ") + c), std::string::npos) << r.output;
+  }
+  std::ifstream in(path("fig4c.csv"));
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "# rig: pneumatic_rotary");
+  while (std::getline(in, line) && line.rfind("#", 0) == 0) {
+  }
+  EXPECT_EQ(line.rfind("t,theta_d,u,theta,dp,omega", 0), 0u) << line;
+  const auto bad = run_command(kRigctl + " run " + config + " --case fig99 --fast --log " + path("x.lcm"));
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.output.find("no case 'fig99'"), std::string::npos) << bad.output;
+}

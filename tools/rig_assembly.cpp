@@ -2,6 +2,7 @@
 
 #include "config/config_reader.hpp"
 #include "drivers/sim_driver.hpp"
+#include "plant/pneumatic_rotary_plant.hpp"
 #include "plant/quarter_car_plant.hpp"
 #include "rt/pi_controller.hpp"
 #include "rt/pvp_controller.hpp"
@@ -56,13 +57,9 @@ std::vector<SensorSpec> dac_specs(const RigConfig& c, const std::vector<ChannelI
   return out;
 }
 
-std::unique_ptr<SimulatedPlant> make_pneumatic_plant(const RigConfig& c) {
-  config_fail(c, "rig", "the pneumatic_rotary plant is not built yet");
-}
-
 std::unique_ptr<SimulatedPlant> make_plant(const RigConfig& c) {
   if (c.rig == "quarter_car") return std::make_unique<QuarterCarPlant>(c.quarter_car);
-  return make_pneumatic_plant(c);
+  return std::make_unique<PneumaticRotaryPlant>(c.pneumatic_rotary);
 }
 
 std::unique_ptr<Driver> make_driver(const RigConfig& c) {
