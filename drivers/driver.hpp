@@ -3,9 +3,23 @@
 // them apart.
 #pragma once
 
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
 #include "rt/sample.hpp"
 
 namespace rigctl {
+
+// What a driver reports about its I/O, off the real-time path.
+struct DriverDiagnostics {
+  // Running totals, e.g. {"modbus_timeouts", 3}, {"can_malformed_frames", 0}.
+  std::vector<std::pair<std::string, int64_t>> counters;
+  // Human-readable events since the previous call, each naming what failed,
+  // e.g. "modbus: timeout reading input registers 0-7 of unit 1".
+  std::vector<std::string> events;
+};
 
 class Driver {
  public:
@@ -31,6 +45,10 @@ class Driver {
 
   // Closes devices. Not real-time.
   virtual void stop() = 0;
+
+  // Counters and new events. Not real-time; safe to call from another thread
+  // while the loop runs.
+  virtual DriverDiagnostics diagnostics() { return {}; }
 
   // True when time is simulated, so the loop may run faster than real time
   // (--fast) with identical results.
