@@ -10,7 +10,7 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 
 packages=(cmake g++ make pkg-config liblcm-dev liblcm-bin libglib2.0-dev libmodbus-dev libspdlog-dev
           libfmt-dev libeigen3-dev libgtest-dev libgmock-dev libsocketcan-dev libyaml-cpp-dev libcli11-dev
-          iproute2)
+          iproute2 socat)
 for arg in "$@"; do
   case "$arg" in
     --plots) packages+=(python3 python3-numpy python3-matplotlib) ;;
