@@ -3,6 +3,8 @@
 #include <filesystem>
 
 #include "config/config_reader.hpp"
+#include "config/canopen_reader.hpp"
+#include "config/modbus_reader.hpp"
 #include "config/plant_readers.hpp"
 
 namespace rigctl {
@@ -130,7 +132,7 @@ RigConfig parse(ConfigReader root, const std::string& case_name) {
   c.file = root.file();
   c.case_name = case_name;
   c.rig = root.choice("rig", known_rig_kinds());
-  c.driver = root.choice("driver", {"sim"});
+  c.driver = root.choice("driver", {"sim", "modbus", "modbus_canopen"});
   c.seed = static_cast<uint64_t>(root.integer("seed", 0, std::numeric_limits<int64_t>::max()));
   c.loop = read_loop(root.child("loop"));
   c.telemetry = read_telemetry(root.child("telemetry"));
@@ -144,6 +146,9 @@ RigConfig parse(ConfigReader root, const std::string& case_name) {
   }
   c.sensors = read_converters(root.child("sensors"), true);
   c.dacs = read_converters(root.child("outputs"), false);
+  if (root.has("modbus") || c.driver != "sim") c.modbus = read_modbus_daq(root.child("modbus"), c.loop.period_s);
+  if (root.has("canopen") || c.driver == "modbus_canopen") c.canopen = read_canopen_valve(root.child("canopen"));
+  if (root.has("driver_start_timeout_s")) c.driver_start_timeout_s = root.number("driver_start_timeout_s", 0.01, 60.0);
   root.reject_unknown_keys();
   return c;
 }

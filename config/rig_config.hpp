@@ -4,9 +4,12 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "drivers/canopen_valve_config.hpp"
+#include "drivers/modbus_daq_config.hpp"
 #include "drivers/sensor_model.hpp"
 #include "plant/pneumatic_rotary_params.hpp"
 #include "plant/quarter_car_params.hpp"
@@ -66,7 +69,10 @@ struct RigConfig {
   std::string file;
   std::string case_name;  // the `cases:` entry applied, "" for none
   std::string rig;
+  // sim: the simulated plant in process. modbus: sensors and valve output on
+  // a Modbus DAQ. modbus_canopen: sensors on the DAQ, valve on CANopen.
   std::string driver = "sim";
+  double driver_start_timeout_s = 2.0;  // hardware: first sample / valve operational within this
   uint64_t seed = 1;
   LoopConfig loop;
   TelemetryConfig telemetry;
@@ -77,6 +83,10 @@ struct RigConfig {
   PneumaticRotaryParams pneumatic_rotary;  // rig pneumatic_rotary
   std::map<std::string, SensorSpec> sensors;  // by channel name
   std::map<std::string, SensorSpec> dacs;     // output converters, by output name (noise unused)
+  // The physical rig's I/O (and what `rigctl rig-sim` exposes): required by
+  // the drivers that use them, optional otherwise.
+  std::optional<ModbusDaqConfig> modbus;
+  std::optional<CanopenValveConfig> canopen;
 };
 
 // Throws ConfigError naming file, line, key and reason. case_name selects an

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "rt/sample.hpp"
+#include "rt/timing_summary.hpp"
 
 namespace rigctl {
 
@@ -49,6 +50,10 @@ class Driver {
   // Counters and new events. Not real-time; safe to call from another thread
   // while the loop runs.
   virtual DriverDiagnostics diagnostics() { return {}; }
+
+  // Round-trip time of the driver's I/O cycles, for the run summary; count 0
+  // when the driver has no wire (the simulated plant).
+  virtual DistributionSummary io_latency() const { return {}; }
 
   // True when time is simulated, so the loop may run faster than real time
   // (--fast) with identical results.

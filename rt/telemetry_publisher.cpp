@@ -16,6 +16,7 @@
 
 #include "rigctl/command_t.hpp"
 #include "rigctl/controller_t.hpp"
+#include "rigctl/driver_status_t.hpp"
 #include "rigctl/sample_t.hpp"
 #include "rigctl/state_t.hpp"
 #include "rigctl/timing_t.hpp"
@@ -150,6 +151,28 @@ bool TelemetryPublisher::push(const TelemetryRecord& record) noexcept {
   return false;
 }
 
+void TelemetryPublisher::set_diagnostics_source(std::function<DriverDiagnostics()> source, std::string driver_name) {
+  diagnostics_ = std::move(source);
+  driver_name_ = std::move(driver_name);
+}
+
+void TelemetryPublisher::publish_driver_status() {
+  if (!diagnostics_) return;
+  DriverDiagnostics d = diagnostics_();
+  if (d.counters.empty() && d.events.empty()) return;
+  rigctl::driver_status_t m;
+  m.utime = meta_.start_utime + last_t_ns_ / 1000;
+  m.driver = driver_name_;
+  for (auto& [name, value] : d.counters) {
+    m.counter_names.push_back(std::move(name));
+    m.counters.push_back(value);
+  }
+  m.num_counters = static_cast<int16_t>(m.counters.size());
+  m.events = std::move(d.events);
+  m.num_events = static_cast<int16_t>(m.events.size());
+  emit(*lcm_, log_.get(), channels_.driver, m.utime, m);
+}
+
 void TelemetryPublisher::start() {
   if (thread_.joinable()) return;
   running_.store(true);
@@ -157,12 +180,15 @@ void TelemetryPublisher::start() {
 }
 
 void TelemetryPublisher::stop() {
+  if (stopped_) return;  // the destructor calls it again
+  stopped_ = true;
   running_.store(false);
   if (thread_.joinable()) thread_.join();
   // Whatever the loop pushed before stop() still goes out (also when the
   // thread was never started).
   TelemetryRecord record;
   while (queue_.try_pop(record)) publish_record(record);
+  publish_driver_status();
   log_.reset();  // lcm_eventlog_destroy flushes and closes the file
 }
 
@@ -180,8 +206,9 @@ void TelemetryPublisher::thread_main() {
     const bool got = queue_.try_pop(record);
     if (got) publish_record(record);
     const auto now = Clock::now();
-    if (log_ && now - last_flush >= kLogFlushInterval) {
-      std::fflush(log_->getFilePtr());
+    if (now - last_flush >= kLogFlushInterval) {
+      publish_driver_status();
+      if (log_) std::fflush(log_->getFilePtr());
       last_flush = now;
     }
     // Polling, not a condition variable: the real-time side must never make
@@ -191,6 +218,7 @@ void TelemetryPublisher::thread_main() {
 }
 
 void TelemetryPublisher::publish_record(const TelemetryRecord& r) {
+  last_t_ns_ = r.sample.t_ns;
   const int64_t utime = meta_.start_utime + r.sample.t_ns / 1000;
   const double t = static_cast<double>(r.sample.t_ns) * 1e-9;
   lcm::LogFile* log = log_.get();

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <atomic>
+#include <functional>
 #include <cstdint>
 #include <memory>
 #include <mutex>
@@ -12,6 +13,7 @@
 #include <thread>
 #include <vector>
 
+#include "drivers/driver.hpp"
 #include "rt/sample.hpp"
 #include "rt/spsc_queue.hpp"
 #include "rt/telemetry_record.hpp"
@@ -43,10 +45,10 @@ struct TelemetryMeta {
 
 // LCM channel names, given the prefix.
 struct TelemetryChannels {
-  std::string sample, command, controller, timing, state;
+  std::string sample, command, controller, timing, state, driver;
   explicit TelemetryChannels(const std::string& prefix)
       : sample(prefix + "SAMPLE"), command(prefix + "COMMAND"), controller(prefix + "CONTROLLER"),
-        timing(prefix + "TIMING"), state(prefix + "STATE") {}
+        timing(prefix + "TIMING"), state(prefix + "STATE"), driver(prefix + "DRIVER") {}
 };
 
 class TelemetryPublisher final : public TelemetrySink {
@@ -63,6 +65,10 @@ class TelemetryPublisher final : public TelemetrySink {
   // Real-time side: never blocks. Returns false and counts a drop when full.
   bool push(const TelemetryRecord& record) noexcept override;
 
+  // Polled about once a second (and at stop) for the driver's counters and
+  // events, published on channels().driver and logged. Set before start().
+  void set_diagnostics_source(std::function<DriverDiagnostics()> source, std::string driver_name);
+
   void start();  // starts the publisher thread
   void stop();   // drains the queue, flushes and closes the log, joins the thread
 
@@ -78,6 +84,7 @@ class TelemetryPublisher final : public TelemetrySink {
  private:
   void thread_main();
   void publish_record(const TelemetryRecord& record);
+  void publish_driver_status();
 
   TelemetryMeta meta_;
   TelemetryChannels channels_;
@@ -90,8 +97,12 @@ class TelemetryPublisher final : public TelemetrySink {
   std::atomic<int64_t> dropped_{0};
   mutable std::mutex latest_mutex_;
   std::optional<TelemetryRecord> latest_;
+  std::function<DriverDiagnostics()> diagnostics_;
+  std::string driver_name_;
+  int64_t last_t_ns_ = 0;  // rig time of the newest record, for driver status time stamps
   RigState last_state_ = RigState::kStarting;
   bool first_record_ = true;
+  bool stopped_ = false;
 };
 
 }  // namespace rigctl

@@ -8,6 +8,7 @@
 
 #include "config/config_reader.hpp"
 #include "tools/log2csv.hpp"
+#include "tools/rig_sim.hpp"
 #include "tools/run_command.hpp"
 
 namespace {
@@ -49,6 +50,18 @@ int main(int argc, char** argv) {
   l2c->add_option("csv", csv_out, "CSV file to write")->required();
   l2c->add_option("--channel-prefix", prefix, "Telemetry channel prefix used by the run");
 
+  rigctl::RigSimOptions sim;
+  double sim_duration = 0.0;
+  std::vector<std::string> fault_texts;
+  auto* sim_cmd = app.add_subcommand("rig-sim", "Simulate the rig's hardware on the far side of the wire (Modbus DAQ, CANopen valve)");
+  sim_cmd->add_option("config", sim.config_path, "Rig config (YAML) with modbus: (and canopen:) sections")->required()->check(CLI::ExistingFile);
+  sim_cmd->add_option("--case", sim.case_name, "Apply a named variant from the config's `cases:`");
+  auto* modbus_opt = sim_cmd->add_option("--modbus", sim.modbus_tcp, "Serve Modbus TCP on HOST:PORT (port 0: any free port)");
+  sim_cmd->add_option("--modbus-rtu", sim.modbus_rtu, "Serve Modbus RTU on this serial device")->excludes(modbus_opt);
+  sim_cmd->add_option("--can-socket", sim.can_socket, "Serve the CANopen valve on this seqpacket socket path");
+  auto* sim_duration_opt = sim_cmd->add_option("--duration", sim_duration, "Stop after this many seconds (default: at SIGINT/SIGTERM)")->check(CLI::PositiveNumber);
+  sim_cmd->add_option("--fault", fault_texts, "Inject a fault, KIND@TIME[:ARG...] (silence, drop, late, exception, stuck, rail, heartbeat, emcy); repeatable");
+
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -57,6 +70,13 @@ int main(int argc, char** argv) {
       install_stop_handlers();
       const auto report = rigctl::run_rig(run, g_stop, std::cout);
       return report.loop.final_state == rigctl::RigState::kFaulted ? 3 : 0;
+    }
+    if (sim_cmd->parsed()) {
+      if (sim_duration_opt->count() > 0) sim.duration_s = sim_duration;
+      for (const auto& f : fault_texts) sim.faults.push_back(rigctl::parse_fault_spec(f));
+      install_stop_handlers();
+      rigctl::run_rig_sim(sim, g_stop, std::cout);
+      return 0;
     }
     if (l2c->parsed()) {
       const auto result = rigctl::log_to_csv(log_in, csv_out, prefix);

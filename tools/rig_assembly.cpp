@@ -1,6 +1,7 @@
 #include "tools/rig_assembly.hpp"
 
 #include "config/config_reader.hpp"
+#include "drivers/hardware_driver.hpp"
 #include "drivers/sim_driver.hpp"
 #include "plant/pneumatic_rotary_plant.hpp"
 #include "plant/quarter_car_plant.hpp"
@@ -57,12 +58,27 @@ std::vector<SensorSpec> dac_specs(const RigConfig& c, const std::vector<ChannelI
   return out;
 }
 
+}  // namespace
+
 std::unique_ptr<SimulatedPlant> make_plant(const RigConfig& c) {
   if (c.rig == "quarter_car") return std::make_unique<QuarterCarPlant>(c.quarter_car);
   return std::make_unique<PneumaticRotaryPlant>(c.pneumatic_rotary);
 }
 
+namespace {
+
+std::unique_ptr<Driver> make_hardware_driver(const RigConfig& c) {
+  std::optional<CanopenValveConfig> valve;
+  if (c.driver == "modbus_canopen") valve = c.canopen;
+  try {
+    return std::make_unique<HardwareDriver>(*c.modbus, valve, c.driver_start_timeout_s);
+  } catch (const std::invalid_argument& e) {
+    config_fail(c, "modbus", e.what());
+  }
+}
+
 std::unique_ptr<Driver> make_driver(const RigConfig& c) {
+  if (c.driver != "sim") return make_hardware_driver(c);
   auto plant = make_plant(c);
   auto sensors = sensor_specs(c, plant->signals());
   auto dacs = dac_specs(c, plant->commands());

@@ -9,6 +9,7 @@
 
 #include "config/rig_config.hpp"
 #include "drivers/driver.hpp"
+#include "plant/simulated_plant.hpp"
 #include "rt/controller.hpp"
 #include "rt/limit_check.hpp"
 #include "rt/setpoint_profile.hpp"
@@ -25,6 +26,10 @@ struct AssembledRig {
 };
 
 AssembledRig assemble_rig(const RigConfig& config);
+
+// The configured rig kind's simulated plant (the in-process driver and
+// `rigctl rig-sim` both step one).
+std::unique_ptr<SimulatedPlant> make_plant(const RigConfig& config);
 
 // Run-file name of the demand for a rig kind ("x_ref" for quarter_car).
 std::string setpoint_name_for(const std::string& rig);

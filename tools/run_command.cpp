@@ -83,6 +83,8 @@ RunReport run_rig(const RunOptions& options, const std::atomic<bool>& stop, std:
   // long before the loop drops telemetry.
   const auto queue_capacity = static_cast<std::size_t>(10.0 / config.loop.period_s);
   TelemetryPublisher publisher(meta, url, report.log_path, queue_capacity);
+  Driver* driver = rig.driver.get();
+  publisher.set_diagnostics_source([driver] { return driver->diagnostics(); }, config.driver);
 
   rig.driver->start();
   publisher.start();  // before the real-time set-up: the publisher keeps normal priority
@@ -140,6 +142,7 @@ RunReport run_rig(const RunOptions& options, const std::atomic<bool>& stop, std:
   if (!options.fast) {
     out << "  wake-up latency: " << describe(t.wakeup_latency) << "\n"
         << "  compute per tick: " << describe(t.compute) << "\n"
+        << (rig.driver->io_latency().count > 0 ? "  I/O round trip: " + describe(rig.driver->io_latency()) + "\n" : "")
         << "  overruns: " << t.overruns << " (missed ticks " << t.missed_ticks << ", policy "
         << to_string(config.loop.overrun_policy) << ")\n";
   }

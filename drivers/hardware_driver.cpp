@@ -1,0 +1,82 @@
+#include "drivers/hardware_driver.hpp"
+
+#include <stdexcept>
+
+namespace rigctl {
+
+HardwareDriver::HardwareDriver(ModbusDaqConfig daq, std::optional<CanopenValveConfig> valve,
+                               double first_sample_timeout_s)
+    : first_sample_timeout_s_(first_sample_timeout_s) {
+  for (const auto& c : daq.inputs) layout_.inputs.push_back({c.name, c.unit});
+  for (const auto& c : daq.outputs) layout_.outputs.push_back({c.name, c.unit});
+  daq_inputs_ = layout_.inputs.size();
+  daq_outputs_ = layout_.outputs.size();
+  daq_ = std::make_unique<ModbusDaq>(std::move(daq));
+  if (valve) {
+    valve_ = std::make_unique<CanopenValve>(std::move(*valve));
+    for (const auto& c : valve_->input_channels()) layout_.inputs.push_back(c);
+    valve_output_ = layout_.outputs.size();
+    layout_.outputs.push_back({valve_->config().setpoint_output, "1"});
+  }
+  // One name, one signal: the loop and the logs address channels by name.
+  for (const auto* list : {&layout_.inputs, &layout_.outputs}) {
+    for (std::size_t i = 0; i < list->size(); ++i) {
+      for (std::size_t j = i + 1; j < list->size(); ++j) {
+        if ((*list)[i].name == (*list)[j].name) {
+          throw std::invalid_argument("channel '" + (*list)[i].name + "' is given twice (DAQ and valve)");
+        }
+      }
+    }
+  }
+  if (layout_.inputs.size() > kMaxInputs) throw std::invalid_argument("more input channels than a sample holds");
+  if (layout_.outputs.size() > kMaxOutputs) throw std::invalid_argument("more output channels than a command holds");
+}
+
+HardwareDriver::~HardwareDriver() {
+  try {
+    stop();
+  } catch (...) {
+  }
+}
+
+void HardwareDriver::start() {
+  start_ns_ = ModbusDaq::now_ns();
+  daq_->start(first_sample_timeout_s_);
+  if (valve_) valve_->start();
+}
+
+bool HardwareDriver::read(Sample& out) {
+  const int64_t now = ModbusDaq::now_ns();
+  out.status = 0;
+  daq_->read_inputs(out, 0, now);
+  if (valve_) valve_->read_actual(out, daq_inputs_, now);
+  out.t_ns = now - start_ns_;
+  return true;
+}
+
+void HardwareDriver::write(const Command& command) {
+  daq_->write_outputs(command.value.data(), daq_outputs_);
+  if (valve_) valve_->write_setpoint(command.value[valve_output_]);
+}
+
+void HardwareDriver::make_safe() noexcept {
+  daq_->make_safe();
+  if (valve_) valve_->make_safe();
+}
+
+void HardwareDriver::stop() {
+  if (valve_) valve_->stop();
+  daq_->stop();
+}
+
+DriverDiagnostics HardwareDriver::diagnostics() {
+  DriverDiagnostics d = daq_->diagnostics();
+  if (valve_) {
+    DriverDiagnostics v = valve_->diagnostics();
+    d.counters.insert(d.counters.end(), v.counters.begin(), v.counters.end());
+    d.events.insert(d.events.end(), v.events.begin(), v.events.end());
+  }
+  return d;
+}
+
+}  // namespace rigctl

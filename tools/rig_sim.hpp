@@ -1,0 +1,33 @@
+// `rigctl rig-sim`: the simulated rig on the far side of the wire. One
+// process steps the configured plant in real time and exposes it as the
+// physical rig's hardware does: a Modbus DAQ server whose input registers are
+// the sensors (calibration applied in reverse) and whose holding register is
+// the valve's analogue command, and/or a CANopen valve node on a seqpacket
+// socket path. Faults are injected at given times.
+#pragma once
+
+#include <atomic>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "tools/fault_spec.hpp"
+
+namespace rigctl {
+
+struct RigSimOptions {
+  std::string config_path;
+  std::string case_name;
+  std::string modbus_tcp;   // "HOST:PORT" (port 0: pick one and print it)
+  std::string modbus_rtu;   // serial device path
+  std::string can_socket;   // seqpacket socket path for the CANopen valve
+  std::optional<double> duration_s;  // default: until SIGINT/SIGTERM
+  std::vector<FaultSpec> faults;
+};
+
+// Prints "rig-sim: modbus listening on HOST:PORT" and "rig-sim: canopen
+// valve on PATH" once ready (tests wait for these lines), then runs.
+void run_rig_sim(const RigSimOptions& options, const std::atomic<bool>& stop, std::ostream& out);
+
+}  // namespace rigctl
