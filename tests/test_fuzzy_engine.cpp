@@ -331,6 +331,24 @@ TEST(FuzzySuspensionController, OpposesBodyMotionAtEachCornerAndClamps) {
   EXPECT_EQ(c.term_names().size(), 6u);
 }
 
+TEST(FuzzySuspensionController, DisplacementInputUsesTheSetpoint) {
+  FuzzySuspensionConfig cfg;
+  cfg.first_input = FuzzyFirstInput::kDisplacement;
+  cfg.engine = paper_fuzzy_spec({0.01, 4.0, 2000.0});  // 10 mm to the universe edge
+  FuzzySuspensionController c(cfg);
+  Sample s;
+  s.value[2] = 0.004;   // z_s
+  s.value[3] = 0.001;   // phi: front corner 0.004 + 1.524e-3, rear 0.004 - 1.156e-3
+  Command cmd;
+  ControllerTerms t;
+  c.update(0.002, s, cmd, t);
+  EXPECT_NEAR(t.term[2], 0.002 - (0.004 + 1.524e-3), 1e-15);
+  EXPECT_NEAR(t.term[4], 0.002 - (0.004 - 1.156e-3), 1e-15);
+  EXPECT_LT(cmd.value[0], cmd.value[1]);  // the front is further above the demand
+  EXPECT_LT(cmd.value[0], 0.0);
+  EXPECT_DOUBLE_EQ(t.error, 0.002 - 0.004);
+}
+
 TEST(FuzzySuspensionController, UpdatesWithoutAllocating) {
   FuzzySuspensionController fuzzy{FuzzySuspensionConfig{}};
   SkyhookController sky{SkyhookConfig{}};

@@ -273,6 +273,21 @@ TEST(HalfCarControl, RandomRoadAndCurveRunsForTheRecord) {
               format_metrics_table({"passive", "fuzzy", "skyhook", "lqr"}, m).c_str());
   for (const auto& x : m) EXPECT_TRUE(std::isfinite(x.rms_acc));
 
+  // The single-hump reading of eq. 9 (0 <= t <= lambda0 / V).
+  HalfCarParams one = HalfCarParams{};
+  one.road.bump.cycles = 1.0;
+  std::vector<Recorded> rec1;
+  for (Controller* c : std::initializer_list<Controller*>{&passive, &fuzzy, &sky, &lqr}) {
+    rec1.push_back(run_closed_loop(*c, one));
+  }
+  SettlingSpec common;  // as for the paper's bump: 5 % of the passive peak for every run
+  common.fraction = 0.0;
+  common.min_band = 0.05 * rec1[0].metrics.peak_z_s;
+  std::vector<SuspensionMetrics> m1;
+  for (const auto& x : rec1) m1.push_back(compute_suspension_metrics(x.run, common));
+  std::printf("\nSingle hump (cycles = 1), pitch plane\n%s",
+              format_metrics_table({"passive", "fuzzy", "skyhook", "lqr"}, m1).c_str());
+
   HalfCarParams r = HalfCarParams::roll_plane();
   SkyhookConfig sc;
   sc.lever_arm = {0.5 * r.track, -0.5 * r.track};

@@ -171,6 +171,57 @@ TEST(HalfCarModel, SimulatorAndStateSpaceModelAgreeWhileTheTyresTouch) {
   EXPECT_NEAR(out[sig::kPhiDdot], dx(half_car_state::kOmega), 1e-10);
 }
 
+TEST(HalfCarModel, RoadAndTyreDampingEnterAsInTheStateSpaceModel) {
+  // Mid-bump, with tyre damping: plant accelerations = A x + B f + E r + E_rate r'.
+  HalfCarParams p;
+  p.tyre_damping_1 = 400.0;
+  p.tyre_damping_2 = 300.0;
+  HalfCarPlant plant(p);
+  HalfCarState s;
+  s.time = p.road.bump.start_time + 0.0031;  // wheel 1 on the first hump, wheel 2 not yet
+  s.z_u1 = 0.01;
+  s.v_u1 = 0.4;
+  s.v_s = -0.02;
+  plant.set_state(s);
+  Signals out;
+  plant.measure(out);
+  const HalfCarModel m = HalfCarModel::build(p);
+  Eigen::Matrix<double, 8, 1> x;
+  x << s.z_s, s.phi, s.z_u1, s.z_u2, s.v_s, s.omega, s.v_u1, s.v_u2;
+  const RoadSample r1 = plant.road().at(0, s.time), r2 = plant.road().at(1, s.time);
+  EXPECT_GT(r1.z, 0.01);
+  EXPECT_EQ(r2.z, 0.0);
+  const Eigen::Matrix<double, 8, 1> dx =
+      m.A * x + m.E * Eigen::Vector2d(r1.z, r2.z) + m.E_rate * Eigen::Vector2d(r1.dz, r2.dz);
+  EXPECT_NEAR(out[sig::kZsDdot], dx(half_car_state::kVs), 1e-9);
+  EXPECT_NEAR(out[sig::kPhiDdot], dx(half_car_state::kOmega), 1e-9);
+  EXPECT_NEAR(out[sig::kZr1], r1.z, 0.0);
+}
+
+TEST(HalfCarModel, OptionalActuatorLagAndDamperAsymmetry) {
+  HalfCarParams p;
+  p.road.kind = RoadKind::kFlat;
+  p.actuator_time_constant = 0.02;
+  HalfCarPlant lagged(p);
+  const auto run = simulate(lagged, 0.02, 0.0025, {1000.0, -500.0});
+  EXPECT_NEAR(run.back()[sig::kSimFAct1], 1000.0 * (1.0 - std::exp(-1.0)), 0.5);
+  EXPECT_NEAR(run.back()[sig::kSimFAct2], -500.0 * (1.0 - std::exp(-1.0)), 0.5);
+  // Rebound (extension) damped twice as hard as compression.
+  HalfCarParams q;
+  q.road.kind = RoadKind::kFlat;
+  q.damper_rebound_factor = 2.0;
+  for (double v : {0.1, -0.1}) {
+    HalfCarPlant plant(q);
+    HalfCarState s;
+    s.v_s = v;  // body moving: both suspensions extend (v > 0) or compress
+    plant.set_state(s);
+    Signals out;
+    plant.measure(out);
+    const double c = v > 0.0 ? 2.0 : 1.0;
+    EXPECT_NEAR(out[sig::kZsDdot], -c * (q.damper_1 + q.damper_2) * v / q.mass_body, 1e-12) << v;
+  }
+}
+
 // ----------------------------------------------------------- eigenfrequencies
 
 TEST(HalfCarModel, EigenfrequenciesMatchTheHandCalculation) {
