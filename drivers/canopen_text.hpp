@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <string>
 
-namespace rigctl {
+namespace rigctl::canopen_text {
 
 // "0x6042" style, upper-case hex with at least `digits` digits.
 inline std::string hex(uint32_t value, int digits) {
@@ -27,4 +27,4 @@ inline std::string milliseconds(int64_t ns) {
   return buffer;
 }
 
-}  // namespace rigctl
+}  // namespace rigctl::canopen_text

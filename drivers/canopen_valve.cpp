@@ -166,6 +166,11 @@ void CanopenValve::write_setpoint(double fraction) noexcept {
   write_setpoint_unchecked(fraction);
 }
 
+ValveIdentity CanopenValve::identity() const {
+  std::lock_guard<std::mutex> lock(admin_mutex_);
+  return identity_;
+}
+
 ValveActual CanopenValve::latest_actual() const noexcept {
   ValveActual a;
   if (!latest_.load(a)) a = ValveActual{};

@@ -29,7 +29,11 @@
 // status word's ready bit is clear (CiA 408 NOT_READY/FAULT_*), when the
 // valve reset itself, when an EMCY with a non-zero error register is active,
 // or when the connection is lost. The loop's limit check then faults on that
-// tick and make_safe() sends the null setpoint at once. Heartbeat loss, a
+// tick and make_safe() sends the null setpoint at once: for a lost heartbeat
+// at most floor(heartbeat_timeout_s / period) + 1 loop periods after the last
+// heartbeat arrived (21 periods for 50 ms at 2.5 ms). The valve itself goes to
+// null when our heartbeat stops for its consumer time (valve_consumer_time_s,
+// written to 0x1016:1 at start-up). Heartbeat loss, a
 // valve reset and a lost connection stay latched until stop()/start(): a
 // flaky link must not silently resume control.
 #pragma once
@@ -57,6 +61,15 @@
 
 namespace rigctl {
 
+// What the valve says it is, read by SDO at start-up (0x1000, 0x1018).
+struct ValveIdentity {
+  uint32_t device_type = 0;  // low 16 bits: device profile number, 408 for a CiA 408 valve
+  uint32_t vendor_id = 0;
+  std::optional<uint32_t> product_code;  // 0x1018:2..4 are optional objects
+  std::optional<uint32_t> revision;
+  std::optional<uint32_t> serial;
+};
+
 class CanopenValve {
  public:
   // Why read_actual() flags the inputs (bits of faults()).
@@ -78,9 +91,11 @@ class CanopenValve {
   // Not real-time. Opens the transport of the config (SocketCAN interface or
   // seqpacket socket path, retrying the connect until the deadline), then:
   // NMT reset communication and wait for the boot-up (reset_on_start),
-  // heartbeat configuration (configure_heartbeats) and the start-up SDO
-  // writes, NMT start, wait for the heartbeat to report operational. All
-  // within config.startup_timeout_s. Throws std::runtime_error naming the node
+  // identity read (0x1000, 0x1018), heartbeat configuration
+  // (configure_heartbeats) and the start-up SDO writes, NMT start, wait for
+  // the heartbeat to report operational and for the first spool actual
+  // value, so the loop's first read finds one. All within
+  // config.startup_timeout_s. Throws std::runtime_error naming the node
   // and the step (an SDO abort names index:subindex and the abort text); the
   // transport is closed then and start() may be called again.
   void start();
@@ -125,6 +140,8 @@ class CanopenValve {
   canopen::NmtState valve_nmt_state() const noexcept {
     return static_cast<canopen::NmtState>(valve_state_.load(std::memory_order_acquire));
   }
+  // Read during the last start() (zeros before).
+  ValveIdentity identity() const;
   // Latest decoded actual value and its receive time (count 0: none yet).
   ValveActual latest_actual() const noexcept;
 
@@ -134,6 +151,11 @@ class CanopenValve {
   void start_session(CanTransport transport, int64_t deadline_ns);
   void run_startup(int64_t deadline_ns);
   void sdo_write(const SdoWrite& w, int64_t deadline_ns);
+  std::optional<uint32_t> sdo_read(uint16_t index, uint8_t subindex, const std::string& what, bool required,
+                                   int64_t deadline_ns);
+  canopen::SdoResult sdo_transfer(const std::optional<canopen::CanFrame>& request, const std::string& what,
+                                  int64_t deadline_ns);
+  void read_identity(int64_t deadline_ns);
   template <typename Pred>
   void pump_until(Pred done, int64_t deadline_ns, const std::string& what);
   [[noreturn]] void fail(const std::string& what) const;
@@ -198,6 +220,7 @@ class CanopenValve {
   // start() and stop()) nor by the I/O thread.
   mutable std::mutex admin_mutex_;
   CanTransport::Counters transport_totals_;  // of transports already closed
+  ValveIdentity identity_;
   BoundedEventLog events_;
 };
 

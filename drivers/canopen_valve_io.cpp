@@ -16,6 +16,9 @@
 namespace rigctl {
 
 using namespace canopen;
+using canopen_text::hex;
+using canopen_text::milliseconds;
+using canopen_text::od_address;
 
 namespace {
 

@@ -17,6 +17,9 @@
 namespace rigctl {
 
 using namespace canopen;
+using canopen_text::hex;
+using canopen_text::milliseconds;
+using canopen_text::od_address;
 
 namespace {
 
@@ -92,6 +95,7 @@ void CanopenValve::run_startup(int64_t deadline_ns) {
                "boot-up message after NMT reset communication");
   }
 
+  read_identity(deadline_ns);
   if (config_.configure_heartbeats) {
     sdo_write({"valve heartbeat producer time (ms)", 0x1017, 0, 2, whole_ms(config_.valve_heartbeat_period_s)},
               deadline_ns);
@@ -115,31 +119,73 @@ void CanopenValve::run_startup(int64_t deadline_ns) {
                            : std::string("last heartbeat reported ") + nmt_state_name(consumer_.last_state());
     throw std::runtime_error(std::string(e.what()) + " (" + seen + ")");
   }
+  // Ready means usable: the loop's first read must not find "never received".
+  pump_until([&] { return actual_count_ > 0; }, deadline_ns,
+             "spool actual value (TPDO" + std::to_string(config_.actual_tpdo) + ", COB-ID " + hex(actual_cob_, 3) +
+                 ") after NMT start; check the valve's TPDO transmission type and event timer (" +
+                 hex(static_cast<uint32_t>(0x1800 + config_.actual_tpdo - 1), 4) + " sub 2 and 5)");
 }
 
-void CanopenValve::sdo_write(const SdoWrite& w, int64_t deadline_ns) {
+canopen::SdoResult CanopenValve::sdo_transfer(const std::optional<CanFrame>& request, const std::string& what,
+                                              int64_t deadline_ns) {
   sdo_result_.reset();
-  const auto request = sdo_.start_download(w.index, w.subindex, w.value, w.size, clock_ns());
-  if (!request) fail("start-up SDO write " + describe(w) + ": SDO client busy");
+  if (!request) fail(what + ": SDO client busy");
   if (!send(*request)) {
     sdo_.cancel();
-    fail("start-up SDO write " + describe(w) + ": cannot send: " + std::strerror(transport_.last_errno()));
+    fail(what + ": cannot send: " + std::strerror(transport_.last_errno()));
   }
-  pump_until([&] { return sdo_result_.has_value(); }, deadline_ns, "SDO response to the start-up write " + describe(w));
+  pump_until([&] { return sdo_result_.has_value(); }, deadline_ns, "SDO response to the " + what);
   const SdoResult r = *sdo_result_;
   sdo_result_.reset();
-  if (r.kind == SdoResult::Kind::kDone) return;
+  if (r.kind != SdoResult::Kind::kDone) counters_.sdo_aborts.fetch_add(1, std::memory_order_relaxed);
+  return r;
+}
 
-  counters_.sdo_aborts.fetch_add(1, std::memory_order_relaxed);
-  std::string msg = "start-up SDO write " + describe(w);
-  if (r.kind == SdoResult::Kind::kAbort) {
-    msg += " aborted with " + hex(r.abort_code, 8) + ": " + r.text;
-    if (r.abort_code == sdo::kAbortTimeout) msg += " (no answer within sdo_timeout_s = " + seconds(config_.sdo_timeout_s) + ")";
-  } else {
-    msg += " failed: " + std::string(r.text);
-  }
+namespace {
+std::string failure_text(const SdoResult& r, double sdo_timeout_s) {
+  if (r.kind != SdoResult::Kind::kAbort) return " failed: " + std::string(r.text);
+  std::string msg = " aborted with " + hex(r.abort_code, 8) + ": " + r.text;
+  if (r.abort_code == sdo::kAbortTimeout) msg += " (no answer within sdo_timeout_s = " + seconds(sdo_timeout_s) + ")";
+  return msg;
+}
+}  // namespace
+
+void CanopenValve::sdo_write(const SdoWrite& w, int64_t deadline_ns) {
+  const std::string what = "start-up SDO write " + describe(w);
+  const SdoResult r = sdo_transfer(sdo_.start_download(w.index, w.subindex, w.value, w.size, clock_ns()), what, deadline_ns);
+  if (r.kind == SdoResult::Kind::kDone) return;
+  const std::string msg = what + failure_text(r, config_.sdo_timeout_s);
   events_.push(prefix() + msg);
   fail(msg);
+}
+
+std::optional<uint32_t> CanopenValve::sdo_read(uint16_t index, uint8_t subindex, const std::string& what, bool required,
+                                               int64_t deadline_ns) {
+  const std::string full = "start-up SDO read of the " + what + " " + od_address(index, subindex);
+  const SdoResult r = sdo_transfer(sdo_.start_upload(index, subindex, clock_ns()), full, deadline_ns);
+  if (r.kind == SdoResult::Kind::kDone) return r.value;
+  const std::string msg = full + failure_text(r, config_.sdo_timeout_s);
+  events_.push(prefix() + msg + (required ? "" : " (optional object: ignored)"));
+  if (required) fail(msg);
+  return std::nullopt;
+}
+
+void CanopenValve::read_identity(int64_t deadline_ns) {
+  ValveIdentity id;
+  id.device_type = *sdo_read(0x1000, 0, "device type", true, deadline_ns);
+  id.vendor_id = *sdo_read(0x1018, 1, "vendor id", true, deadline_ns);
+  id.product_code = sdo_read(0x1018, 2, "product code", false, deadline_ns);
+  id.revision = sdo_read(0x1018, 3, "revision number", false, deadline_ns);
+  id.serial = sdo_read(0x1018, 4, "serial number", false, deadline_ns);
+  auto opt = [](const std::optional<uint32_t>& v) { return v ? hex(*v, 8) : std::string("n/a"); };
+  events_.push(prefix() + "identity: device type " + hex(id.device_type, 8) + ", vendor " + hex(id.vendor_id, 8) +
+               ", product " + opt(id.product_code) + ", revision " + opt(id.revision) + ", serial " + opt(id.serial));
+  // Not fatal: some valves report a manufacturer-specific device type.
+  if ((id.device_type & 0xFFFF) != 408) {
+    events_.push(prefix() + "warning: device type " + hex(id.device_type, 8) + " does not name the CiA 408 profile");
+  }
+  std::lock_guard<std::mutex> lock(admin_mutex_);
+  identity_ = id;
 }
 
 }  // namespace rigctl

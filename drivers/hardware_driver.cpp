@@ -7,9 +7,16 @@ namespace rigctl {
 HardwareDriver::HardwareDriver(ModbusDaqConfig daq, std::optional<CanopenValveConfig> valve,
                                double first_sample_timeout_s)
     : first_sample_timeout_s_(first_sample_timeout_s) {
+  // With the valve on CANopen, the DAQ's analogue valve output (if the
+  // config keeps one for `driver: modbus`) is not driven: one config serves
+  // both drivers by changing the driver line only.
+  if (valve) {
+    std::erase_if(daq.outputs, [&](const ModbusChannel& c) { return c.name == valve->setpoint_output; });
+  }
   for (const auto& c : daq.inputs) layout_.inputs.push_back({c.name, c.unit});
   for (const auto& c : daq.outputs) layout_.outputs.push_back({c.name, c.unit});
   daq_inputs_ = layout_.inputs.size();
+  max_output_age_ns_ = static_cast<int64_t>(daq.max_sample_age_s * 1e9);
   daq_outputs_ = layout_.outputs.size();
   daq_ = std::make_unique<ModbusDaq>(std::move(daq));
   if (valve) {
@@ -40,9 +47,11 @@ HardwareDriver::~HardwareDriver() {
 }
 
 void HardwareDriver::start() {
-  start_ns_ = ModbusDaq::now_ns();
   daq_->start(first_sample_timeout_s_);
   if (valve_) valve_->start();
+  // Rig time starts with the loop, not with the devices' start-up (the
+  // valve's SDO configuration takes a good part of a second).
+  start_ns_ = ModbusDaq::now_ns();
 }
 
 bool HardwareDriver::read(Sample& out) {
@@ -51,7 +60,9 @@ bool HardwareDriver::read(Sample& out) {
   daq_->read_inputs(out, 0, now);
   if (valve_) valve_->read_actual(out, daq_inputs_, now);
   out.t_ns = now - start_ns_;
-  return true;
+  // Commands the DAQ could not deliver leave the valve on an old command:
+  // as dangerous as stale inputs, so the loop faults.
+  return daq_outputs_ == 0 || daq_->output_age_ns(now) <= max_output_age_ns_;
 }
 
 void HardwareDriver::write(const Command& command) {

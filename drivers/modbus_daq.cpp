@@ -368,7 +368,7 @@ void ModbusDaq::run_io() noexcept {
     if (r.kind == ModbusErrorKind::kLink) {
       lose_connection(modbus_error_text(r.error));
     } else {
-      io.link.flush();  // a late reply must not be taken for the next request's
+      io.link.drain();  // a late reply must not be taken for the next request's
       // Silent for a whole reconnect interval: assume a half-open TCP
       // connection (device rebooted, cable moved) and open a new one.
       if (k.transport == ModbusTransport::kTcp && now_ns() - io.last_answer_ns > reconnect) {

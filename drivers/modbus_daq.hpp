@@ -19,9 +19,11 @@
 // flags it stale in Sample::status once older than max_sample_age_s, and the
 // loop's limit check then makes the rig safe.
 //
-// Failures. A timeout ends the cycle at once (the next request would most
-// likely time out too and the cycle must stay short); the reply that may
-// still arrive is flushed. An exception response only fails its own block.
+// Failures. A timeout or a mismatched reply ends the cycle (the next request
+// would most likely fail too); the line is then drained for one response
+// timeout so a late reply cannot be taken for a later request's (see
+// ModbusLink::drain). An exception response only fails its own block: its
+// inputs go stale, the other blocks are still read.
 // A link error (reset, closed, serial I/O error) closes the connection; the
 // I/O thread reconnects every reconnect_interval_s without a restart. A TCP
 // connection that has answered nothing for reconnect_interval_s is also
@@ -32,7 +34,14 @@
 //
 // Output latency: up to one poll period plus the reads, because the I/O
 // thread runs on its own clock rather than being woken by the loop (waking it
-// would need a system call on the real-time path).
+// would need a system call on the real-time path). Failed writes make
+// output_age_ns() grow, the outputs' counterpart of stale inputs.
+//
+// Priority: the inputs are only as fresh as the I/O thread is punctual, so
+// config io_priority gives it SCHED_FIFO (just below the loop's); mlockall of
+// the loop's set-up covers it. Measured on the 2-core VM under load (two busy
+// loops plus other builds): ticks with a stale input went from 0.7-3 % at
+// normal priority to 0.03-0.3 % (2 ms timeout, 7.5 ms maximum age).
 #pragma once
 
 #include <array>

@@ -13,9 +13,10 @@
 // * Error recovery NONE. MODBUS_ERROR_RECOVERY_LINK retries a failed send in
 //   an endless close/sleep/connect loop (the thread could never be stopped)
 //   and sleeps a response timeout before each flush; PROTOCOL also sleeps.
-//   The I/O thread instead flushes at once after a timeout or a mismatched
-//   reply and reconnects on its own schedule (ModbusDaq, reconnect_interval_s),
-//   so every libmodbus call returns within its timeout.
+//   The I/O thread instead drains the line for one response timeout after a
+//   timeout or a mismatched reply (see drain()) and reconnects on its own
+//   schedule (ModbusDaq, reconnect_interval_s), so every call here returns
+//   within a bounded time.
 // * RTU: the input buffer is flushed before every request. A serial reply has
 //   no transaction id, so a reply that arrived after its timeout would be
 //   taken for the next identical request's. (One that arrives while the next
@@ -28,8 +29,12 @@
 
 #include <modbus/modbus.h>
 
+#include <poll.h>
+#include <time.h>
+
 #include <algorithm>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <stdexcept>
 
@@ -138,8 +143,21 @@ void ModbusLink::before_request(int unit_id) noexcept {
   if (connection_.transport == ModbusTransport::kRtu) modbus_flush(ctx_);
 }
 
-void ModbusLink::flush() noexcept {
-  if (open_) modbus_flush(ctx_);
+void ModbusLink::drain() noexcept {
+  if (!open_) return;
+  modbus_flush(ctx_);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(connection_.response_timeout_s);
+  pollfd p{modbus_get_socket(ctx_), POLLIN, 0};
+  for (;;) {
+    const auto left = std::chrono::ceil<std::chrono::microseconds>(deadline - std::chrono::steady_clock::now()).count();
+    if (left <= 0) return;
+    const timespec ts{static_cast<time_t>(left / 1000000), static_cast<long>(left % 1000000) * 1000};
+    p.revents = 0;
+    const int rc = ppoll(&p, 1, &ts, nullptr);
+    if (rc < 0 && errno == EINTR) continue;
+    if (rc <= 0 || (p.revents & (POLLERR | POLLHUP | POLLNVAL)) != 0) return;  // quiet, or broken: the next request tells
+    modbus_flush(ctx_);
+  }
 }
 
 }  // namespace rigctl

@@ -55,9 +55,13 @@ class ModbusLink {
   ModbusResult read(const ReadBlock& block, uint16_t* dest) noexcept;
   // FC 6 for a single register (what the simplest modules support), FC 16 otherwise.
   ModbusResult write(const WriteBlock& block, const uint16_t* src) noexcept;
-  // Discards whatever the device sent that nobody asked for (a reply that
-  // arrived after its timeout), so it cannot be taken for the next reply.
-  void flush() noexcept;
+  // After a timeout or a mismatched reply: discards everything the device
+  // sends during the next response timeout. A bare flush is not enough: after
+  // a late reply was taken for the next request's, that request's own reply
+  // is usually still on its way; flushed too early, it would be taken for
+  // the request after, and the connection would stay one reply behind for
+  // good. Costs at most one response timeout, only after an error.
+  void drain() noexcept;
 
   const std::string& endpoint() const noexcept { return endpoint_; }
   double connect_timeout_s() const noexcept;

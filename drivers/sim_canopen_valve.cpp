@@ -57,6 +57,18 @@ std::vector<OdEntry> make_dictionary(const SimCanopenValveConfig& c) {
     od.push_back({cia408::kPrsActualValue, 0, 1, A::kReadOnly, 1});
     od.push_back({cia408::kPrsActualValue, 1, 2, A::kReadOnly, 0});
   }
+  // PDO communication parameters, so a start-up list written for a real valve
+  // (e.g. TPDO transmission type 255 with an event timer) also works here.
+  // Stored; only the TPDO event timer (sub 5, ms) takes effect.
+  const auto rpdo_comm = static_cast<uint16_t>(0x1400 + c.setpoint_rpdo - 1);
+  const auto tpdo_comm = static_cast<uint16_t>(0x1800 + c.actual_tpdo - 1);
+  od.push_back({rpdo_comm, 0, 1, A::kReadOnly, 2});
+  od.push_back({rpdo_comm, 1, 4, A::kReadWrite, cob_id(rpdo(c.setpoint_rpdo), c.node_id)});
+  od.push_back({rpdo_comm, 2, 1, A::kReadWrite, 255});
+  od.push_back({tpdo_comm, 0, 1, A::kReadOnly, 5});
+  od.push_back({tpdo_comm, 1, 4, A::kReadWrite, cob_id(tpdo(c.actual_tpdo), c.node_id)});
+  od.push_back({tpdo_comm, 2, 1, A::kReadWrite, 255});
+  od.push_back({tpdo_comm, 5, 2, A::kReadWrite, static_cast<uint32_t>(std::lround(c.tpdo_period_s * 1000.0))});
   return od;
 }
 
@@ -185,6 +197,7 @@ void SimCanopenValve::reset_communication(int64_t now, bool whole_dictionary) {
   fault_.store(false, std::memory_order_release);
   after_write(0x1017, 0, now);
   after_write(0x1016, 1, now);
+  tpdo_period_ns_ = static_cast<int64_t>(config_.tpdo_period_s * 1e9);
   queue(encode_heartbeat(config_.node_id, NmtState::kBootUp), now);
   set_nmt(NmtState::kPreOperational);
   next_tpdo_ns_ = now;
@@ -269,6 +282,9 @@ void SimCanopenValve::after_write(uint16_t index, uint8_t subindex, int64_t now)
     consumer_ = HeartbeatConsumer(master, static_cast<int64_t>(entry & 0xFFFF) * kMs);
   } else if (index == cia408::kControlWord) {
     apply_control_word(static_cast<uint16_t>(od(index, 0).value));
+  } else if (index == 0x1800 + config_.actual_tpdo - 1 && subindex == 5) {
+    const uint32_t ms = od(index, 5).value;
+    tpdo_period_ns_ = ms > 0 ? static_cast<int64_t>(ms) * kMs : static_cast<int64_t>(config_.tpdo_period_s * 1e9);
   } else if (index == cia408::kSplSetpoint && subindex == 1) {
     setpoint_ = sdo_sign_extend(od(index, 1).value, 2) * cia408::kSpoolScale;
   }
@@ -324,7 +340,7 @@ void SimCanopenValve::step(int64_t now) {
     CanFrame f;
     encode_pdo(tpdo_map_, actual_cob_, std::span<const double>(values, tpdo_map_.size()), f);
     queue(f, now);
-    const auto period = static_cast<int64_t>(config_.tpdo_period_s * 1e9);
+    const int64_t period = tpdo_period_ns_;
     next_tpdo_ns_ = now - next_tpdo_ns_ > period ? now + period : next_tpdo_ns_ + period;  // no burst after a stall
   }
 }

@@ -12,9 +12,11 @@
 //    start-up SDO writes matter), control word MHD = 111 (ACTIVE) and no
 //    device fault. Otherwise its target is null (0).
 //  * TPDO: the spool actual value (status word, spool actual [, pressure]) is
-//    sent every tpdo_period_s while operational (event-timer style, no SYNC:
-//    the loop's period and the valve's cycle stay independent; the client
-//    bounds the age of what it uses).
+//    sent every tpdo_period_s while operational (transmission type 255 with
+//    an event timer; SYNC is not implemented: the loop's period and the
+//    valve's cycle stay independent and the client bounds the age of what it
+//    uses). Writing the event timer 0x1800+n-1 sub 5 (ms, > 0) changes the
+//    period; the other PDO communication objects are stored only.
 //  * Heartbeat: produced every 0x1017 ms (0: off). Master heartbeat consumer
 //    0x1016:1 (node << 16 | ms); monitoring starts with the first master
 //    heartbeat. When it times out: spool target null, device state
@@ -49,7 +51,7 @@ namespace rigctl {
 struct SimCanopenValveConfig {
   uint8_t node_id = 1;
   double spool_time_constant_s = 0.004;  // first-order lag of the spool
-  double tpdo_period_s = 0.001;          // spool actual value sent this often while operational
+  double tpdo_period_s = 0.001;          // spool actual value sent this often while operational (until 0x1800:5 is written)
   int setpoint_rpdo = 1;
   int actual_tpdo = 1;
   bool with_pressure = false;            // TPDO carries the pressure actual value 0x6381:1
@@ -161,6 +163,7 @@ class SimCanopenValve {
   uint16_t control_word_ = 0x0001;
   int64_t last_step_ns_ = 0;
   int64_t next_tpdo_ns_ = 0;
+  int64_t tpdo_period_ns_ = 0;
   int64_t miss_heartbeats_until_ns_ = 0;
   int64_t delay_ns_ = 0;
   int64_t fail_safe_ns_ = 0;

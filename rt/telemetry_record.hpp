@@ -36,7 +36,7 @@ enum class EventCode : uint8_t {
   kStopRequested,    // SIGINT/SIGTERM or --duration reached
   kLimitTripped,     // input `channel` left its range with `value`
   kInputInvalid,     // driver flagged input `channel` invalid (NaN, stale)
-  kDriverReadFailed,
+  kDriverReadFailed,  // no usable sample, or the driver could not deliver the commands
   kQueueOverflow,    // telemetry records were dropped (value = count)
 };
 

@@ -75,7 +75,10 @@ CanopenValveConfig client_config() {
   c.sdo_timeout_s = 1.0;
   c.startup_timeout_s = 10.0;
   c.actual_max_age_s = 0.5;
-  c.startup_sdo = {{"device_mode", 0x6042, 0, 1, 1}, {"control_word", 0x6040, 0, 2, 0x0007}};
+  c.startup_sdo = {{"device_mode", 0x6042, 0, 1, 1},
+                   {"control_word", 0x6040, 0, 2, 0x0007},
+                   {"tpdo1_transmission_type", 0x1800, 2, 1, 255},  // as for a real valve: event-driven TPDO
+                   {"tpdo1_event_timer_ms", 0x1800, 5, 2, 2}};
   return c;
 }
 
@@ -266,11 +269,17 @@ TEST(CanopenValve, StartUpConfiguresTheValveAndReachesOperational) {
   EXPECT_EQ(p.sim->od_value(0x6040, 0), 0x0007U);
   EXPECT_EQ(p.sim->od_value(0x1017, 0), 50U);
   EXPECT_EQ(p.sim->od_value(0x1016, 1), canopen::consumer_heartbeat_entry(127, 1000));
-  EXPECT_EQ(p.sim->stats().sdo_writes, 4U);
+  EXPECT_EQ(p.sim->od_value(0x1800, 5), 2U);
+  EXPECT_EQ(p.sim->stats().sdo_writes, 6U);
+  const ValveIdentity id = p.valve.identity();
+  EXPECT_EQ(id.device_type & 0xFFFF, 408U);
+  EXPECT_EQ(id.product_code, 0x0408U);
+  EXPECT_EQ(id.serial, 1U);
   EXPECT_GE(p.sim->stats().nmt_commands, 2U);  // reset communication, start
   EXPECT_TRUE(wait_for([&] { return p.valve.healthy(now_ns()); })) << "faults " << p.valve.faults();
   Diag d(p.valve);
   EXPECT_TRUE(d.has_event({"started", "operational"})) << d.dump();
+  EXPECT_TRUE(d.has_event({"identity: device type 0x00000198", "serial 0x00000001"})) << d.dump();
   EXPECT_EQ(d.counter("canopen_sdo_aborts"), 0);
 }
 
@@ -378,7 +387,7 @@ TEST(CanopenValve, LateSdoAnswerTimesOutNamingTheObject) {
     FAIL() << "start() succeeded";
   } catch (const std::runtime_error& e) {
     const std::string msg = e.what();
-    EXPECT_NE(msg.find("0x1017:00"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("0x1000:00"), std::string::npos) << msg;  // the first SDO: reading the device type
     EXPECT_NE(msg.find("SDO protocol timed out"), std::string::npos) << msg;
   }
 }
@@ -403,6 +412,23 @@ TEST(CanopenValve, StartFailsClearlyWhenNothingAnswers) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find(dir.socket()), std::string::npos) << e.what();
   }
+}
+
+TEST(CanopenValve, StartWaitsForTheFirstActualValueAndNamesTheTpdoWhenNoneComes) {
+  CanopenValveConfig c = client_config();
+  c.actual_tpdo = 2;  // the node sends its actual value on TPDO1
+  c.startup_timeout_s = 0.5;
+  CanopenValve valve(c);
+  auto [a, b] = socketpair_seqpacket();
+  SimCanopenValve sim(std::move(b), sim_config());
+  try {
+    valve.start(std::move(a));
+    FAIL() << "start() succeeded";
+  } catch (const std::runtime_error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("TPDO2, COB-ID 0x281"), std::string::npos) << msg;
+  }
+  EXPECT_FALSE(valve.running());
 }
 
 TEST(CanopenValve, RealTimeApiIsHarmlessBeforeStart) {

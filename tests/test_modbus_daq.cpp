@@ -9,6 +9,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
+#include <new>
 #include <cmath>
 #include <functional>
 #include <iostream>
@@ -25,6 +27,22 @@
 #include "rt/histogram.hpp"
 
 using namespace rigctl;
+
+// Counts this thread's heap allocations, to show the loop-side calls make none
+// (the I/O and server threads allocate freely and are not counted).
+namespace {
+thread_local long t_allocations = 0;
+}
+[[gnu::noinline]] void* operator new(std::size_t n) {
+  ++t_allocations;
+  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
+  throw std::bad_alloc();
+}
+[[gnu::noinline]] void* operator new[](std::size_t n) { return operator new(n); }
+[[gnu::noinline]] void operator delete(void* p) noexcept { std::free(p); }
+[[gnu::noinline]] void operator delete[](void* p) noexcept { std::free(p); }
+[[gnu::noinline]] void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+[[gnu::noinline]] void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 
 namespace {
 
@@ -240,7 +258,7 @@ TEST_F(ModbusDaqTest, LoopSideReadNeverBlocksWhileTheIoThreadWaitsForATimeout) {
   const int64_t timeouts_before = daq_->counters().timeouts;
   DurationHistogram calls(100, 100000);  // 0.1 us bins up to 10 ms
   Sample s;
-  const int64_t end = ModbusDaq::now_ns() + 800'000'000;
+  const int64_t end = ModbusDaq::now_ns() + 1'500'000'000;  // spans a whole timeout + drain of 600 ms
   while (ModbusDaq::now_ns() < end) {
     const int64_t t0 = ModbusDaq::now_ns();
     daq_->read_inputs(s, 0, t0);
@@ -255,6 +273,23 @@ TEST_F(ModbusDaqTest, LoopSideReadNeverBlocksWhileTheIoThreadWaitsForATimeout) {
   // bounds: this VM may preempt any single call for milliseconds.
   EXPECT_LT(summary.p99_ns, 500'000);
   EXPECT_LT(summary.max_ns, 100'000'000);
+}
+
+TEST_F(ModbusDaqTest, LoopSideCallsDoNotAllocate) {
+  start_client();
+  ASSERT_TRUE(wait_until([&] { return shows(kValuesA); }));
+  Sample s;
+  const double command[2] = {0.1, kNaN};
+  const long before = t_allocations;
+  for (int i = 0; i < 2000; ++i) {
+    const int64_t now = ModbusDaq::now_ns();
+    daq_->read_inputs(s, 0, now);
+    daq_->write_outputs(command, 2);
+    (void)daq_->output_age_ns(now);
+    if (i % 100 == 0) daq_->make_safe();
+    if (i == 1000) sim_->set_silent(true);  // and while requests time out
+  }
+  EXPECT_EQ(t_allocations - before, 0);
 }
 
 TEST_F(ModbusDaqTest, SilentServerMakesInputsStaleAndIsCountedAndLogged) {
@@ -301,6 +336,35 @@ TEST_F(ModbusDaqTest, LateRepliesTimeOutAndDoNotPoisonLaterRequests) {
   sim_->set_reply_delay(0.0);
   sim_->set_inputs(kValuesB.data(), kValuesB.size());
   ASSERT_TRUE(wait_until([&] { return shows(kValuesB); }));
+  EXPECT_EQ(daq_->counters().connection_losses, 0);
+}
+
+TEST_F(ModbusDaqTest, OneLateReplyDoesNotLeaveTheConnectionOneReplyBehind) {
+  // One reply later than the timeout is consumed by the next request (wrong
+  // transaction id). If the client then only flushed at once, its own reply,
+  // still on its way, would poison the request after, and so on forever.
+  auto c = sim_->client_config();
+  c.connection.reconnect_interval_s = 60.0;  // a reconnect would hide the desynchronisation
+  start_client(c);
+  // Every reply takes 2 ms (well inside the 20 ms timeout), like a busy
+  // module's: a reply then always arrives after the client has handled a
+  // mismatch, which is when a plain flush cannot catch it.
+  sim_->set_reply_delay(0.002);
+  ASSERT_TRUE(wait_until([&] { return shows(kValuesA); }));
+  for (int episode = 0; episode < 3; ++episode) {
+    const int64_t timeouts = daq_->counters().timeouts;
+    sim_->set_reply_delay(0.03);  // 1.5 response timeouts, for the request being served now
+    ASSERT_TRUE(wait_until([&] { return daq_->counters().timeouts > timeouts; }));
+    sim_->set_reply_delay(0.002);
+    const double* values = episode % 2 == 0 ? kValuesB.data() : kValuesA.data();
+    sim_->set_inputs(values, kValuesA.size());
+    ASSERT_TRUE(wait_until([&] { return shows(episode % 2 == 0 ? kValuesB : kValuesA); }, 5.0))
+        << "episode " << episode << ": " << daq_->counters().protocol_errors << " bad replies\n" << events();
+    // And it stays in step: no further bad replies.
+    const int64_t bad = daq_->counters().protocol_errors;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    EXPECT_EQ(daq_->counters().protocol_errors, bad) << "episode " << episode;
+  }
   EXPECT_EQ(daq_->counters().connection_losses, 0);
 }
 

@@ -215,6 +215,14 @@ void run_rig_sim(const RigSimOptions& o, const std::atomic<bool>& stop, std::ost
       command[0] = outputs[static_cast<std::size_t>(valve_daq_output)];
     }
     if (!std::isfinite(command[0])) command[0] = 0.0;
+    // Twice a second, what the rig does: lets a person (and the end-to-end
+    // tests) see that a fault left the valve at null.
+    if (tick % std::max<int64_t>(1, std::llround(0.5 / config.loop.period_s)) == 0) {
+      out << "rig-sim: t = " << t << " s, valve " << plant->commands()[0].name << " = " << command[0];
+      for (std::size_t i = 0; i < inputs.size() && i < 3; ++i) out << ", " << daq_config.inputs[i].name << " = " << inputs[i];
+      out << "\n";
+      out.flush();
+    }
     plant->advance(command, config.loop.period_s);
     deadline += period_ns;
     clock.sleep_until(deadline);

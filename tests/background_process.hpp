@@ -1,0 +1,102 @@
+// A program started by a test in the background, its output in a file, so
+// the test can wait for a line, read what it printed and stop it by pid.
+#pragma once
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace rigctl::test {
+
+class BackgroundProcess {
+ public:
+  BackgroundProcess(const std::vector<std::string>& argv, const std::string& output_path) : output_path_(output_path) {
+    pid_ = fork();
+    if (pid_ == 0) {
+      const int fd = ::open(output_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      dup2(fd, 1);
+      dup2(fd, 2);
+      std::vector<char*> args;
+      for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+      args.push_back(nullptr);
+      execv(args[0], args.data());
+      _exit(127);
+    }
+  }
+  ~BackgroundProcess() { stop(); }
+  BackgroundProcess(const BackgroundProcess&) = delete;
+  BackgroundProcess& operator=(const BackgroundProcess&) = delete;
+
+  std::string output() const {
+    std::ifstream in(output_path_);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  }
+
+  // Waits until the output contains `text`; false after the timeout or when
+  // the process ended first.
+  bool wait_for(const std::string& text, double timeout_s) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+    while (std::chrono::steady_clock::now() < deadline) {
+      if (output().find(text) != std::string::npos) return true;
+      if (exited()) return output().find(text) != std::string::npos;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return false;
+  }
+
+  // SIGINT, then wait (SIGKILL after 10 s). Returns the exit status, -1 if killed.
+  int stop() {
+    if (pid_ <= 0) return status_;
+    if (!exited()) {
+      kill(pid_, SIGINT);
+      for (int i = 0; i < 1000 && !exited(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      if (!exited()) {
+        kill(pid_, SIGKILL);
+        int st = 0;
+        waitpid(pid_, &st, 0);
+        status_ = -1;
+      }
+    }
+    pid_ = -1;
+    return status_;
+  }
+
+  // Waits for the process to end by itself.
+  int wait() {
+    if (pid_ <= 0) return status_;
+    int st = 0;
+    waitpid(pid_, &st, 0);
+    status_ = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+    pid_ = -1;
+    return status_;
+  }
+
+ private:
+  bool exited() {
+    if (pid_ <= 0) return true;
+    int st = 0;
+    const pid_t r = waitpid(pid_, &st, WNOHANG);
+    if (r == pid_) {
+      status_ = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+      pid_ = -1;
+      return true;
+    }
+    return false;
+  }
+
+  std::string output_path_;
+  pid_t pid_ = -1;
+  int status_ = -1;
+};
+
+}  // namespace rigctl::test
