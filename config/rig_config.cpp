@@ -81,7 +81,13 @@ ProfileConfig read_profile(ConfigReader r, const std::string& config_file) {
                                     : (std::filesystem::path(config_file).parent_path() / file).string();
     c.csv_column = r.text("column");
   } else {
-    c.start = r.number("start", -10.0, 10.0);
+    // `start: measured` begins the lead-in where the feedback stands, so a
+    // run never starts with a jump in demand (the physical rig's choice).
+    if (r.has("start") && r.text("start") == "measured") {
+      c.start_from_measurement = true;
+    } else {
+      c.start = r.number("start", -10.0, 10.0);
+    }
     c.hold_s = r.number("hold_s", 0.0, 1e5);
     c.ramp_target = r.number("ramp_target", -10.0, 10.0);
     c.ramp_rate = r.number("ramp_rate", 1e-6, 100.0);

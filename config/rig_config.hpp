@@ -53,6 +53,7 @@ struct ProfileConfig {
   double filter_tau_s = 0.0;
   // ramp_steps and sine; positions in the feedback channel's unit (m or rad)
   double start = 0.0, hold_s = 0.0, ramp_target = 0.0, ramp_rate = 0.0;
+  bool start_from_measurement = false;  // `start: measured`: begin where the rig stands
   std::vector<double> steps;  // ramp_steps
   double step_hold_s = 0.0;
   double amplitude = 0.0, frequency_hz = 0.0, cycles = 0.0;  // sine

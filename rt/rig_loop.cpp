@@ -53,6 +53,9 @@ LoopResult RigLoop::run(const std::atomic<bool>& stop_requested) {
         break;
       }
 
+      if (tick == 0 && options_.start_from_input >= 0) {
+        profile_.start_from(record.sample.value[static_cast<std::size_t>(options_.start_from_input)]);
+      }
       const double setpoint = profile_.next(static_cast<double>(record.sample.t_ns) * 1e-9);
       controller_.update(setpoint, record.sample, record.command, record.controller);
       driver_.write(record.command);

@@ -23,6 +23,7 @@ struct LoopOptions {
   OverrunPolicy overrun_policy = OverrunPolicy::kSkip;
   int64_t max_ticks = 0;          // run length; the run ends after this many ticks
   int64_t timing_every_ticks = 400;  // publish timing statistics this often (1 s at 2.5 ms)
+  int start_from_input = -1;  // >= 0: the profile starts from this input's first value (bumpless start)
 };
 
 struct LoopResult {

@@ -11,6 +11,15 @@ namespace rigctl {
 
 double LeadIn::duration() const noexcept { return hold_s + std::abs(target - start) / rate; }
 
+void LeadIn::rebase(double position) noexcept {
+  const double ramp_time = std::abs(target - start) / rate;
+  start = position;
+  const double distance = std::abs(target - start);
+  // A configured lead-in without a ramp keeps none: then any move is at the
+  // configured rate (the hold then simply lasts a little longer overall).
+  if (ramp_time > 0.0 && distance > 0.0) rate = distance / ramp_time;
+}
+
 double LeadIn::at(double t) const noexcept {
   if (t <= hold_s) return start;
   const double travelled = (t - hold_s) * rate;

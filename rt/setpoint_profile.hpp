@@ -14,6 +14,9 @@ class SetpointProfile {
   virtual ~SetpointProfile() = default;
   virtual double at(double t) const noexcept = 0;  // demand at rig time t [s], SI units
   virtual double duration() const noexcept = 0;    // natural length [s]
+  // Begin from this position instead of the configured start (a run that
+  // starts where the rig stands: no jump). Profiles without a lead-in ignore it.
+  virtual void start_from(double /*position*/) noexcept {}
 };
 
 // Hold `start` for hold_s, then move to `target` at constant rate.
@@ -24,6 +27,9 @@ struct LeadIn {
   double rate = 0.02;   // [unit/s], > 0
   double duration() const noexcept;
   double at(double t) const noexcept;
+  // Start from `position` instead, arriving at the same time as configured
+  // (the rate adapts): the run keeps its timing wherever the rig stood.
+  void rebase(double position) noexcept;
 };
 
 // The paper's test: ramp to mid-stroke, then steps relative to it.
@@ -33,6 +39,7 @@ class RampStepsProfile final : public SetpointProfile {
   RampStepsProfile(LeadIn lead_in, std::vector<double> steps, double step_hold_s);
   double at(double t) const noexcept override;
   double duration() const noexcept override;
+  void start_from(double position) noexcept override { lead_in_.rebase(position); }
   double step_time(std::size_t i) const noexcept;  // when step i begins [s]
   std::size_t step_count() const noexcept { return steps_.size(); }
 
@@ -46,6 +53,7 @@ class RampStepsProfile final : public SetpointProfile {
 class SineProfile final : public SetpointProfile {
  public:
   SineProfile(LeadIn lead_in, double amplitude, double frequency_hz, double cycles);
+  void start_from(double position) noexcept override { lead_in_.rebase(position); }
   double at(double t) const noexcept override;
   double duration() const noexcept override;
 
@@ -74,6 +82,13 @@ class FilteredProfile {
  public:
   FilteredProfile(std::unique_ptr<SetpointProfile> raw, double tau_s, double period_s);
   void reset() noexcept { primed_ = false; }
+  // Start from the measured position: the lead-in ramps from there and the
+  // filter starts there, so a run never begins with a step in demand.
+  void start_from(double position) noexcept {
+    raw_->start_from(position);
+    y_ = position;
+    primed_ = true;
+  }
   // Called once per tick with increasing t.
   double next(double t) noexcept;
   const SetpointProfile& raw() const noexcept { return *raw_; }

@@ -74,3 +74,14 @@ TEST(Profile, CsvTableInterpolatesAndRejectsBadRows) {
   EXPECT_THROW(TableProfile::from_csv(back, "x_ref"), std::runtime_error);
   std::filesystem::remove_all(dir);
 }
+
+TEST(Profile, StartingFromTheMeasuredPositionKeepsTheTiming) {
+  RampStepsProfile p(paper_lead_in(), {0.05}, 4.0);
+  p.start_from(0.02);  // the rod stands at 20 mm, not at home
+  EXPECT_DOUBLE_EQ(p.at(0.5), 0.02);           // holds where it stands: no jump
+  EXPECT_NEAR(p.at(3.0), 0.02 + 0.03, 1e-12);  // halfway through the ramp at the same time
+  EXPECT_DOUBLE_EQ(p.step_time(0), 5.0);       // steps keep their times
+  FilteredProfile f(std::make_unique<RampStepsProfile>(paper_lead_in(), std::vector<double>{0.05}, 4.0), 0.25, 0.0025);
+  f.start_from(-0.01);
+  EXPECT_NEAR(f.next(0.0), -0.01, 1e-12) << "the filter starts at the measured position too";
+}

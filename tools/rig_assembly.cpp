@@ -160,6 +160,7 @@ AssembledRig assemble_rig(const RigConfig& c) {
   rig.limits = LimitCheck(std::move(limits), layout.inputs.size());
   rig.profile = make_profile(c, rig.profile_duration_s);
   rig.setpoint_name = setpoint_name_for(c.rig);
+  if (c.profile.start_from_measurement) rig.profile_start_input = layout.input_index(c.controller.feedback);
   return rig;
 }
 

@@ -23,6 +23,7 @@ struct AssembledRig {
   LimitCheck limits;
   std::string setpoint_name;  // run-file column of the demand, e.g. "x_ref"
   double profile_duration_s = 0.0;
+  int profile_start_input = -1;  // the feedback input the profile starts from, -1: the configured start
 };
 
 AssembledRig assemble_rig(const RigConfig& config);

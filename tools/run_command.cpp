@@ -62,6 +62,7 @@ RunReport run_rig(const RunOptions& options, const std::atomic<bool>& stop, std:
   loop_options.period_ns = std::llround(config.loop.period_s * 1e9);
   loop_options.overrun_policy = config.loop.overrun_policy;
   loop_options.max_ticks = std::llround(duration / config.loop.period_s);
+  loop_options.start_from_input = rig.profile_start_input;
   loop_options.timing_every_ticks = std::max<int64_t>(1, std::llround(config.loop.timing_publish_s / config.loop.period_s));
 
   RunReport report;
