@@ -3,9 +3,9 @@
 // on 127.0.0.1 and a seqpacket socket path, compared with the in-process
 // simulation; and injected faults, each detected and leading to a safe rig.
 //
-// Timing on this shared 2-core VM: millisecond stalls happen, so the test
-// config allows 10 ms replies and 50 ms (20 periods) of sample age; the
-// fault assertions are stated in those terms.
+// Timing on this shared 2-core VM: stalls of tens of milliseconds happen
+// when other work runs, so the test config allows 10 ms replies and 100 ms
+// (40 periods) of sample age; the fault assertions are stated in those terms.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -26,7 +26,7 @@ namespace {
 const std::string kRigctl = RIGCTL_BINARY;
 const std::string kConfig = std::string(RIGCTL_SOURCE_DIR) + "/config/quarter_car.yaml";
 constexpr double kPeriod = 0.0025;
-constexpr double kMaxAge = 0.05;
+constexpr double kMaxAge = 0.1;
 
 std::string read_file(const std::string& p) {
   std::ifstream in(p);
@@ -95,7 +95,9 @@ class HardwareInTheLoop : public ::testing::Test {
   int start_rig_sim(const std::vector<std::string>& extra) {
     std::vector<std::string> argv{kRigctl, "rig-sim", write_config("sim", 1502), "--modbus", "127.0.0.1:0"};
     argv.insert(argv.end(), extra.begin(), extra.end());
-    sim_ = std::make_unique<BackgroundProcess>(argv, path("rig-sim.out"));
+    // A fresh output file per start: waiting on an old one would find the
+    // previous instance's port.
+    sim_ = std::make_unique<BackgroundProcess>(argv, path("rig-sim-" + std::to_string(++sims_) + ".out"));
     EXPECT_TRUE(sim_->wait_for("modbus listening on", 10.0)) << sim_->output();
     std::smatch m;
     const std::string out = sim_->output();
@@ -104,6 +106,7 @@ class HardwareInTheLoop : public ::testing::Test {
   }
 
   std::unique_ptr<BackgroundProcess> sim_;
+  int sims_ = 0;
   fs::path dir_;
 };
 
@@ -254,4 +257,28 @@ TEST_F(HardwareInTheLoop, EmcyFromTheValveIsDecodedAndFaultsTheLoop) {
   EXPECT_EQ(run.exit_code, 3) << run.output;
   EXPECT_NE(run.output.find("faulted (input_invalid: x_s"), std::string::npos) << run.output;
   EXPECT_NE(read_file(path("f.lcm")).find("0x5000"), std::string::npos) << "EMCY code in the log";
+}
+
+TEST_F(HardwareInTheLoop, OpenCircuitTransducerAtTheRailTripsTheStrokeLimit) {
+  // x_r's register forced to the top of its range: 0.19999 m, beyond the
+  // configured stroke limit of 0.172 m.
+  const int port = start_rig_sim({"--fault", "rail@3:x_r"});
+  ASSERT_GT(port, 0);
+  const auto run = run_command(kRigctl + " run " + write_config("modbus", port) + " --duration 10 --log " + path("f.lcm"));
+  EXPECT_EQ(run.exit_code, 3) << run.output;
+  EXPECT_NE(run.output.find("faulted (limit_tripped: x_r = 0.1999"), std::string::npos) << run.output;
+}
+
+TEST_F(HardwareInTheLoop, DroppedConnectionAndLateRepliesAreStaleDataAndFaultTheLoop) {
+  for (const std::string fault : {"drop@3", "late@3:0.03:1"}) {
+    const int port = start_rig_sim({"--fault", fault});
+    ASSERT_GT(port, 0);
+    const auto run = run_command(kRigctl + " run " + write_config("modbus", port) + " --duration 10 --log " +
+                                 path("f.lcm"));
+    EXPECT_EQ(run.exit_code, 3) << fault << ": " << run.output;
+    EXPECT_TRUE(run.output.find("faulted (input_invalid") != std::string::npos ||
+                run.output.find("faulted (driver_read_failed") != std::string::npos)
+        << fault << ": " << run.output;
+    sim_->stop();
+  }
 }

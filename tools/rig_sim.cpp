@@ -1,5 +1,6 @@
 #include "tools/rig_sim.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <random>
@@ -11,6 +12,7 @@
 #include "drivers/sim_canopen_valve.hpp"
 #include "drivers/sim_modbus_daq.hpp"
 #include "rt/loop_clock.hpp"
+#include "rt/realtime.hpp"
 #include "tools/rig_assembly.hpp"
 
 namespace rigctl {
@@ -157,6 +159,16 @@ void run_rig_sim(const RigSimOptions& o, const std::atomic<bool>& stop, std::ost
   if (!config.modbus) throw ConfigError(config.file + ": modbus: missing (rig-sim exposes the rig's Modbus DAQ)");
   const bool with_valve = !o.can_socket.empty();
   if (with_valve && !config.canopen) throw ConfigError(config.file + ": canopen: missing (needed for --can-socket)");
+
+  // The simulated hardware answers like hardware: its threads (created
+  // below, inheriting this policy) run at real-time priority when permitted,
+  // just under the controller's loop, so a busy machine does not make the
+  // far side look faulty.
+  RealtimeConfig rt = config.loop.realtime;
+  rt.priority = std::max(1, rt.priority - 10);
+  rt.cpu = -1;
+  RealtimeSession realtime(rt);
+  for (const auto& w : realtime.warnings()) out << "rig-sim: " << w << "\n";
 
   ModbusDaqConfig daq_config = *config.modbus;
   daq_config.connection = far_side_connection(o, daq_config.connection);
