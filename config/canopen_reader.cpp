@@ -96,6 +96,7 @@ CanopenValveConfig read_canopen_valve(ConfigReader r) {
   if (r.has("reset_on_start")) c.reset_on_start = r.boolean("reset_on_start");
 
   c.sdo_timeout_s = r.number("sdo_timeout_s", 0.001, 10.0);
+  if (r.has("io_priority")) c.io_priority = static_cast<int>(r.integer("io_priority", 0, 99));
   if (r.has("startup_timeout_s")) c.startup_timeout_s = r.number("startup_timeout_s", 0.01, 600.0);
   c.actual_max_age_s = r.number("actual_max_age_s", 1e-6, 10.0);
 

@@ -3,6 +3,10 @@
 // canopen_valve_io.cpp.
 #include "drivers/canopen_valve.hpp"
 
+#include "rt/realtime.hpp"
+
+#include <cstring>
+
 #include <algorithm>
 #include <cmath>
 #include <ctime>
@@ -118,6 +122,14 @@ void CanopenValve::start_session(CanTransport transport, int64_t deadline_ns) {
   clear_fault(kFaultNotRunning | kFaultHeartbeatLost | kFaultValveReset | kFaultNotOperational | kFaultLinkLost);
   stop_requested_.store(false, std::memory_order_release);
   io_thread_ = std::thread([this] { io_loop(); });
+  // Heartbeats and actual values are stamped by this thread: starved, it
+  // would make a healthy valve look stale.
+  if (config_.io_priority > 0) {
+    if (const int rc = set_fifo_priority(io_thread_, config_.io_priority); rc != 0) {
+      events_.push(prefix() + "cannot give the I/O thread SCHED_FIFO priority " +
+                   std::to_string(config_.io_priority) + " (" + std::strerror(rc) + "); it runs best effort");
+    }
+  }
   running_.store(true, std::memory_order_release);
   events_.push(prefix() + "started: configured, NMT operational");
 }

@@ -38,6 +38,7 @@ struct CanopenValveConfig {
 
   bool reset_on_start = true;   // NMT reset communication and wait for the boot-up first
   double sdo_timeout_s = 0.1;
+  int io_priority = 0;  // SCHED_FIFO priority of the I/O thread (0: normal scheduling)
   double startup_timeout_s = 2.0;  // bounds the whole of start(): connect, boot-up, SDO, operational
   std::vector<SdoWrite> startup_sdo;
 

@@ -1,5 +1,7 @@
 #include "drivers/modbus_daq.hpp"
 
+#include "rt/realtime.hpp"
+
 #include <pthread.h>
 #include <sched.h>
 #include <spdlog/spdlog.h>
@@ -131,9 +133,7 @@ void ModbusDaq::start(double first_sample_timeout_s) {
   if (config_.io_priority > 0) {
     // Set from here, so a refusal (not root, no rtprio limit) is reported
     // like the loop's own: a warning, and the thread runs best effort.
-    sched_param param{};
-    param.sched_priority = config_.io_priority;
-    const int rc = pthread_setschedparam(thread_.native_handle(), SCHED_FIFO, &param);
+    const int rc = set_fifo_priority(thread_, config_.io_priority);
     if (rc != 0) {
       std::lock_guard lock(mutex_);
       add_event("modbus " + endpoint_ + ": cannot give the I/O thread SCHED_FIFO priority " +

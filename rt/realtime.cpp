@@ -25,6 +25,12 @@ void prefault_stack() {
 }
 }  // namespace
 
+int set_fifo_priority(std::thread& thread, int priority) {
+  sched_param param{};
+  param.sched_priority = priority;
+  return pthread_setschedparam(thread.native_handle(), SCHED_FIFO, &param);
+}
+
 RealtimeSession::RealtimeSession(const RealtimeConfig& config) {
   if (!config.enabled) {
     warnings_.push_back("real-time set-up disabled in config: running best effort");

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace rigctl {
@@ -16,6 +17,11 @@ struct RealtimeConfig {
   int cpu = -1;                // pin the loop thread to this CPU; -1 = no pinning
   bool hold_cpu_dma_latency = true;  // keep /dev/cpu_dma_latency at 0 while running
 };
+
+// Gives a running thread SCHED_FIFO at `priority` (an I/O thread just below
+// the loop). Returns 0 or the error number; the caller reports a refusal and
+// the thread runs best effort.
+int set_fifo_priority(std::thread& thread, int priority);
 
 // Holds what was acquired (the cpu_dma_latency file) until destroyed.
 class RealtimeSession {
