@@ -3,6 +3,7 @@
 #pragma once
 
 #include "config/config_reader.hpp"
+#include "plant/half_car_params.hpp"
 #include "plant/pneumatic_rotary_params.hpp"
 #include "plant/quarter_car_params.hpp"
 
@@ -10,5 +11,6 @@ namespace rigctl {
 
 void read_quarter_car_plant(ConfigReader r, QuarterCarParams& p);
 void read_pneumatic_rotary_plant(ConfigReader r, PneumaticRotaryParams& p);
+void read_half_car_plant(ConfigReader r, HalfCarParams& p);
 
 }  // namespace rigctl

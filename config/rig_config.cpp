@@ -46,6 +46,16 @@ TelemetryConfig read_telemetry(ConfigReader r) {
 ControllerConfig read_controller(ConfigReader r, const std::string& rig, double period_s) {
   ControllerConfig c;
   // Each rig has the controller of its paper.
+  if (rig == "half_car") {
+    // Passive, the paper's fuzzy controller, or a baseline. Every
+    // controller's settings are required: `rigctl compare` runs them all.
+    c.type = r.choice("type", suspension_controller_types());
+    c.feedback = r.text("feedback");
+    read_suspension_controller(r, c.suspension);
+    c.output = c.suspension.output_1;
+    r.reject_unknown_keys();
+    return c;
+  }
   c.type = r.choice("type", {rig == "pneumatic_rotary" ? "pvp" : "pi"});
   c.feedback = r.text("feedback");
   c.output = r.text("output");
@@ -73,9 +83,14 @@ ControllerConfig read_controller(ConfigReader r, const std::string& rig, double 
 
 ProfileConfig read_profile(ConfigReader r, const std::string& config_file) {
   ProfileConfig c;
-  c.type = r.choice("type", {"ramp_steps", "sine", "csv"});
+  c.type = r.choice("type", {"ramp_steps", "sine", "csv", "hold"});
   c.filter_tau_s = r.number("filter_tau_s", 0.0, 100.0);
-  if (c.type == "csv") {
+  if (c.type == "hold") {
+    // A constant demand (a regulator: the half car holds its body at rest
+    // while the road moves under it).
+    c.value = r.number("value", -10.0, 10.0);
+    c.duration_s = r.number("duration_s", 1e-3, 1e7);
+  } else if (c.type == "csv") {
     const std::filesystem::path file = r.text("file");
     c.csv_file = file.is_absolute() ? file.string()
                                     : (std::filesystem::path(config_file).parent_path() / file).string();
@@ -147,6 +162,10 @@ RigConfig parse(ConfigReader root, const std::string& case_name) {
   if (root.has("limits")) c.limits = read_limits(root.child("limits"));
   if (c.rig == "quarter_car") {
     read_quarter_car_plant(root.child("plant"), c.quarter_car);
+  } else if (c.rig == "half_car") {
+    read_half_car_plant(root.child("plant"), c.half_car);
+    c.suspension_report = read_suspension_report(root.child("report"));
+    c.suspension_optimize = read_suspension_optimize(root.child("optimize"));
   } else {
     read_pneumatic_rotary_plant(root.child("plant"), c.pneumatic_rotary);
   }

@@ -8,9 +8,11 @@
 #include <string>
 #include <vector>
 
+#include "config/suspension_controller_reader.hpp"
 #include "drivers/canopen_valve_config.hpp"
 #include "drivers/modbus_daq_config.hpp"
 #include "drivers/sensor_model.hpp"
+#include "plant/half_car_params.hpp"
 #include "plant/pneumatic_rotary_params.hpp"
 #include "plant/quarter_car_params.hpp"
 #include "rt/pi_controller.hpp"
@@ -22,7 +24,7 @@ namespace rigctl {
 
 // Rig kinds this build knows; others are a config error naming the list.
 inline const std::vector<std::string>& known_rig_kinds() {
-  static const std::vector<std::string> kinds{"quarter_car", "pneumatic_rotary"};
+  static const std::vector<std::string> kinds{"quarter_car", "pneumatic_rotary", "half_car"};
   return kinds;
 }
 
@@ -40,16 +42,17 @@ struct TelemetryConfig {
 };
 
 struct ControllerConfig {
-  std::string type = "pi";  // pi (quarter_car) | pvp (pneumatic_rotary)
+  std::string type = "pi";  // pi (quarter_car) | pvp (pneumatic_rotary) | passive, fuzzy, skyhook, lqr (half_car)
   std::string feedback;     // input channel name
-  std::string output;       // output channel name
+  std::string output;       // output channel name (half_car: suspension.output_1 and _2)
   PiConfig pi;              // type pi; channel indices resolved when the rig is assembled
   PvpConfig pvp;            // type pvp
   std::string pressure;     // type pvp: differential-pressure input channel
+  SuspensionControllerSettings suspension;  // half_car: every controller's settings (compare runs them all)
 };
 
 struct ProfileConfig {
-  std::string type = "ramp_steps";  // ramp_steps | sine | csv
+  std::string type = "ramp_steps";  // ramp_steps | sine | csv | hold
   double filter_tau_s = 0.0;
   // ramp_steps and sine; positions in the feedback channel's unit (m or rad)
   double start = 0.0, hold_s = 0.0, ramp_target = 0.0, ramp_rate = 0.0;
@@ -59,6 +62,7 @@ struct ProfileConfig {
   double amplitude = 0.0, frequency_hz = 0.0, cycles = 0.0;  // sine
   std::string csv_file;    // csv: path resolved against the config's folder
   std::string csv_column;  // csv: column with the demand
+  double value = 0.0, duration_s = 0.0;  // hold: a constant demand for duration_s
 };
 
 struct LimitConfig {
@@ -82,6 +86,9 @@ struct RigConfig {
   std::vector<LimitConfig> limits;
   QuarterCarParams quarter_car;          // rig quarter_car
   PneumaticRotaryParams pneumatic_rotary;  // rig pneumatic_rotary
+  HalfCarParams half_car;                  // rig half_car
+  SuspensionReportConfig suspension_report;      // half_car `report:` (rigctl compare)
+  SuspensionOptimizeConfig suspension_optimize;  // half_car `optimize:` (rigctl optimize)
   std::map<std::string, SensorSpec> sensors;  // by channel name
   std::map<std::string, SensorSpec> dacs;     // output converters, by output name (noise unused)
   // The physical rig's I/O (and what `rigctl rig-sim` exposes): required by

@@ -76,6 +76,19 @@ class TableProfile final : public SetpointProfile {
   std::vector<double> t_, value_;
 };
 
+// A constant demand for `duration` seconds: a regulator whose disturbance
+// comes from elsewhere (the half car holds its body at rest while the road
+// moves under it). Starts where it is told to, nothing to rebase.
+class HoldProfile final : public SetpointProfile {
+ public:
+  HoldProfile(double value, double duration_s) : value_(value), duration_(duration_s) {}
+  double at(double /*t*/) const noexcept override { return value_; }
+  double duration() const noexcept override { return duration_; }
+
+ private:
+  double value_, duration_;
+};
+
 // Discrete first-order low-pass (exact for a piecewise-constant input):
 // y_k = y_{k-1} + (1 - exp(-Ts/tau)) (x_k - y_{k-1}); tau = 0 passes through.
 class FilteredProfile {

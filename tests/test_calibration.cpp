@@ -12,34 +12,10 @@
 #include <vector>
 
 #include "drivers/calibration.hpp"
+#include "allocation_counter.hpp"
 
 using namespace rigctl;
 
-// Counts heap allocations so to_si()/to_raw() can be checked allocation free.
-namespace {
-std::atomic<long> g_allocations{0};
-}
-// Out of line so that the compiler does not pair the inlined free() with a
-// `new` expression and warn about a mismatch: the pair is malloc/free here.
-[[gnu::noinline]] void* operator new(std::size_t n) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
-  throw std::bad_alloc();
-}
-[[gnu::noinline]] void* operator new[](std::size_t n) { return operator new(n); }
-// The nothrow forms too (std::stable_sort's buffer uses them), so every
-// allocation is counted and pairs with the free() below.
-[[gnu::noinline]] void* operator new(std::size_t n, const std::nothrow_t&) noexcept {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return std::malloc(n == 0 ? 1 : n);
-}
-[[gnu::noinline]] void* operator new[](std::size_t n, const std::nothrow_t& t) noexcept { return operator new(n, t); }
-[[gnu::noinline]] void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
-[[gnu::noinline]] void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
-[[gnu::noinline]] void operator delete(void* p) noexcept { std::free(p); }
-[[gnu::noinline]] void operator delete[](void* p) noexcept { std::free(p); }
-[[gnu::noinline]] void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-[[gnu::noinline]] void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 
 namespace {
 
@@ -314,11 +290,11 @@ TEST(Calibration, DispatchesToTheKindHeld) {
 TEST(Calibration, ConversionsDoNotAllocate) {
   const std::vector<Calibration> channels = {Calibration(), LinearCalibration(0.25, 3.0), rising(), falling()};
   double sum = 0.0;
-  const long before = g_allocations.load();
+  const long before = rigctl::test::allocation_count();
   for (int i = 0; i < 10000; ++i) {
     const double x = i * 0.07 - 350.0;
     for (const Calibration& c : channels) sum += c.to_raw(c.to_si(x));
   }
-  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_EQ(rigctl::test::allocation_count() - before, 0);
   EXPECT_TRUE(std::isfinite(sum));
 }

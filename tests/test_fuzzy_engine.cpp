@@ -18,30 +18,10 @@
 #include "rt/fuzzy_suspension_controller.hpp"
 #include "rt/lqr_controller.hpp"
 #include "rt/skyhook_controller.hpp"
+#include "allocation_counter.hpp"
 
 using namespace rigctl;
 
-// Counts heap allocations so the run-time paths can be shown allocation free.
-namespace {
-std::atomic<long> g_allocations{0};
-}
-[[gnu::noinline]] void* operator new(std::size_t n) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
-  throw std::bad_alloc();
-}
-[[gnu::noinline]] void* operator new[](std::size_t n) { return operator new(n); }
-[[gnu::noinline]] void* operator new(std::size_t n, const std::nothrow_t&) noexcept {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return std::malloc(n == 0 ? 1 : n);
-}
-[[gnu::noinline]] void* operator new[](std::size_t n, const std::nothrow_t& t) noexcept { return operator new(n, t); }
-[[gnu::noinline]] void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
-[[gnu::noinline]] void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
-[[gnu::noinline]] void operator delete(void* p) noexcept { std::free(p); }
-[[gnu::noinline]] void operator delete[](void* p) noexcept { std::free(p); }
-[[gnu::noinline]] void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-[[gnu::noinline]] void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 
 namespace {
 
@@ -357,7 +337,7 @@ TEST(FuzzySuspensionController, UpdatesWithoutAllocating) {
   Sample s;
   Command cmd;
   ControllerTerms t;
-  const long before = g_allocations.load();
+  const long before = rigctl::test::allocation_count();
   double sink = 0.0;
   for (int k = 0; k < 1000; ++k) {
     for (std::size_t i = 0; i < 12; ++i) s.value[i] = 0.01 * std::sin(0.1 * k + static_cast<double>(i));
@@ -370,6 +350,6 @@ TEST(FuzzySuspensionController, UpdatesWithoutAllocating) {
     const std::array<double, 2> in{s.value[0], s.value[1]};
     sink += engine.evaluate(in);
   }
-  EXPECT_EQ(g_allocations.load(), before);
+  EXPECT_EQ(rigctl::test::allocation_count(), before);
   EXPECT_TRUE(std::isfinite(sink));
 }

@@ -16,24 +16,8 @@
 #include "plant/bladder_hysteresis.hpp"
 #include "plant/coulomb_friction.hpp"
 #include "plant/pneumatic_rotary_plant.hpp"
+#include "allocation_counter.hpp"
 
-// Counts heap allocations so the real-time path can be shown allocation-free.
-namespace {
-std::atomic<long> g_allocations{0};
-}  // namespace
-
-// Out of line so that the compiler does not pair the inlined free() with a
-// `new` expression and warn about a mismatch: the pair is malloc/free here.
-[[gnu::noinline]] void* operator new(std::size_t n) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
-  throw std::bad_alloc();
-}
-[[gnu::noinline]] void* operator new[](std::size_t n) { return operator new(n); }
-[[gnu::noinline]] void operator delete(void* p) noexcept { std::free(p); }
-[[gnu::noinline]] void operator delete[](void* p) noexcept { std::free(p); }
-[[gnu::noinline]] void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-[[gnu::noinline]] void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 
 namespace rigctl {
 namespace {
@@ -129,13 +113,13 @@ TEST(PneumaticRotaryPlant, AdvanceAndMeasureDoNotAllocate) {
   p.brake.level = 0.02;
   PneumaticRotaryPlant plant(p);
   std::array<double, sig::kCount> out{};
-  const long before = g_allocations.load();
+  const long before = rigctl::test::allocation_count();
   for (int i = 0; i < 2000; ++i) {
     const double u = (i / 200) % 2 == 0 ? 1.5 : -1.5;  // stick, slip and reversals
     plant.advance({&u, 1}, kDt);
     plant.measure(out);
   }
-  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_EQ(rigctl::test::allocation_count() - before, 0);
   EXPECT_GT(std::abs(out[sig::kTheta]), 0.0);
 }
 

@@ -15,24 +15,8 @@
 
 #include "plant/bearing_friction.hpp"
 #include "plant/quarter_car_plant.hpp"
+#include "allocation_counter.hpp"
 
-// Counts heap allocations so the real-time path can be shown allocation-free.
-namespace {
-std::atomic<long> g_allocations{0};
-}  // namespace
-
-// Out of line so that the compiler does not pair the inlined free() with a
-// `new` expression and warn about a mismatch: the pair is malloc/free here.
-[[gnu::noinline]] void* operator new(std::size_t n) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
-  throw std::bad_alloc();
-}
-[[gnu::noinline]] void* operator new[](std::size_t n) { return operator new(n); }
-[[gnu::noinline]] void operator delete(void* p) noexcept { std::free(p); }
-[[gnu::noinline]] void operator delete[](void* p) noexcept { std::free(p); }
-[[gnu::noinline]] void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-[[gnu::noinline]] void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 
 namespace rigctl {
 namespace {
@@ -121,13 +105,13 @@ TEST(QuarterCarPlant, AdvanceAndMeasureDoNotAllocate) {
   p.bearing_friction.enabled = true;
   QuarterCarPlant plant(p);
   std::array<double, sig::kCount> out{};
-  const long before = g_allocations.load();
+  const long before = rigctl::test::allocation_count();
   for (int i = 0; i < 400; ++i) {
     const double u = i < 200 ? 0.4 : -0.4;  // crosses stick, slip and reversals
     plant.advance({&u, 1}, kDt);
     plant.measure(out);
   }
-  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_EQ(rigctl::test::allocation_count() - before, 0);
 }
 
 TEST(QuarterCarPlant, CommandSaturatesAtRatedCurrent) {

@@ -7,9 +7,13 @@
 #include <iostream>
 
 #include "config/config_reader.hpp"
+#include "tools/bench_command.hpp"
+#include "tools/diag_command.hpp"
 #include "tools/log2csv.hpp"
+#include "tools/optimize_command.hpp"
 #include "tools/rig_sim.hpp"
 #include "tools/run_command.hpp"
+#include "tools/suspension_report.hpp"
 
 namespace {
 
@@ -62,6 +66,39 @@ int main(int argc, char** argv) {
   auto* sim_duration_opt = sim_cmd->add_option("--duration", sim_duration, "Stop after this many seconds (default: at SIGINT/SIGTERM)")->check(CLI::PositiveNumber);
   sim_cmd->add_option("--fault", fault_texts, "Inject a fault, KIND@TIME[:ARG...] (silence, drop, late, exception, stuck, rail, heartbeat, emcy); repeatable");
 
+  rigctl::CompareOptions compare;
+  auto* compare_cmd = app.add_subcommand("compare", "Half car: passive, fuzzy, skyhook and LQR on the configured road, metrics beside the paper's");
+  compare_cmd->add_option("config", compare.config_path, "Half-car config (YAML), e.g. config/half_car.yaml")->required()->check(CLI::ExistingFile);
+  compare_cmd->add_option("--case", compare.case_name, "Apply a named variant from the config's `cases:` (e.g. iso_c)");
+  compare_cmd->add_option("--out", compare.out_dir, "Folder for the CSV run files and metrics.json (default: <log_dir>/half_car-compare[-CASE])");
+
+  rigctl::OptimizeOptions optimize;
+  int optimize_evaluations = 0;
+  auto* optimize_cmd = app.add_subcommand("optimize", "Half car: search springs and dampers within Table 2 (NLopt) for the weighted comfort/handling cost");
+  optimize_cmd->add_option("config", optimize.config_path, "Half-car config (YAML) with an optimize: section")->required()->check(CLI::ExistingFile);
+  optimize_cmd->add_option("--case", optimize.case_name, "Apply a named variant from the config's `cases:`");
+  auto* evaluations_opt = optimize_cmd->add_option("--evaluations", optimize_evaluations, "Simulation runs of the search (overrides optimize.evaluations)")->check(CLI::PositiveNumber);
+  optimize_cmd->add_option("--out", optimize.out_path, "JSON file for the optimum (default: <log_dir>/half_car-optimum[-CASE].json)");
+  optimize_cmd->add_flag("--quiet{false}", optimize.progress, "No progress display on stderr");
+
+  rigctl::BenchOptions bench;
+  auto* bench_cmd = app.add_subcommand("bench", "Benchmarks: loop timing vs cyclictest, plant speed and accuracy vs a reference integrator, I/O, scaling (BENCHMARKS.md)");
+  bench_cmd->add_flag("--quick", bench.quick, "Seconds instead of minutes: checks that every section runs (rough numbers)");
+  bench_cmd->add_option("--json", bench.json_path, "Write every result to this JSON file");
+  bench_cmd->add_option("--config-dir", bench.config_dir, "Folder with quarter_car.yaml and pneumatic_rotary.yaml (default: config)")->check(CLI::ExistingDirectory);
+  bench_cmd->add_option("--section", bench.sections, "Run only this section; repeatable")->check(CLI::IsMember(rigctl::bench_section_names()));
+
+  rigctl::DiagnoseCommandOptions diag;
+  auto* diag_cmd = app.add_subcommand("diagnose", "Model-discrepancy diagnosis of a run file (shared/spec/measured-data.md)");
+  diag_cmd->add_option("--rig", diag.rig, "Rig kind: linear_axis, damper, quarter_car")->required();
+  diag_cmd->add_option("--data", diag.data_path, "Run file (CSV)")->required();
+  diag_cmd->add_option("--config", diag.config_path, "Rig config (default: nominal parameters)");
+  diag_cmd->add_option("--json", diag.json_path, "Write the diagnosis as JSON");
+  diag_cmd->add_option("--report", diag.report_path, "Write a self-contained HTML report with plots");
+  diag_cmd->add_flag("--drop-bad-rows", diag.drop_bad_rows, "Drop (and count) rows with bad cells instead of failing");
+  diag_cmd->add_option("--decimate", diag.decimate, "Keep every Nth sample (default: the rig's choice)");
+  diag_cmd->add_flag("--quiet", diag.quiet, "No progress on stderr");
+
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -78,6 +115,21 @@ int main(int argc, char** argv) {
       rigctl::run_rig_sim(sim, g_stop, std::cout);
       return 0;
     }
+    if (compare_cmd->parsed()) {
+      rigctl::run_compare(compare, std::cout);
+      return 0;
+    }
+    if (optimize_cmd->parsed()) {
+      if (evaluations_opt->count() > 0) optimize.evaluations = optimize_evaluations;
+      rigctl::run_optimize(optimize, std::cout, std::cerr);
+      return 0;
+    }
+    if (bench_cmd->parsed()) {
+      for (int i = 0; i < argc; ++i) bench.command_line += (i > 0 ? " " : "") + std::string(argv[i]);
+      install_stop_handlers();
+      return rigctl::run_bench(bench, g_stop, std::cout);
+    }
+    if (diag_cmd->parsed()) return rigctl::run_diagnose(diag, std::cout, std::cerr);
     if (l2c->parsed()) {
       const auto result = rigctl::log_to_csv(log_in, csv_out, prefix);
       std::cout << "log2csv: " << result.rows << " rows of " << result.rig << " written to " << csv_out;

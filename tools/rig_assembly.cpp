@@ -3,10 +3,15 @@
 #include "config/config_reader.hpp"
 #include "drivers/hardware_driver.hpp"
 #include "drivers/sim_driver.hpp"
+#include "plant/half_car_plant.hpp"
 #include "plant/pneumatic_rotary_plant.hpp"
 #include "plant/quarter_car_plant.hpp"
+#include "rt/fuzzy_suspension_controller.hpp"
+#include "rt/lqr_controller.hpp"
 #include "rt/pi_controller.hpp"
 #include "rt/pvp_controller.hpp"
+#include "rt/skyhook_controller.hpp"
+#include "rt/suspension_controller.hpp"
 
 namespace rigctl {
 
@@ -62,6 +67,7 @@ std::vector<SensorSpec> dac_specs(const RigConfig& c, const std::vector<ChannelI
 
 std::unique_ptr<SimulatedPlant> make_plant(const RigConfig& c) {
   if (c.rig == "quarter_car") return std::make_unique<QuarterCarPlant>(c.quarter_car);
+  if (c.rig == "half_car") return std::make_unique<HalfCarPlant>(c.half_car);
   return std::make_unique<PneumaticRotaryPlant>(c.pneumatic_rotary);
 }
 
@@ -96,7 +102,76 @@ int required_input(const RigConfig& c, const ChannelLayout& layout, const std::s
   return index;
 }
 
+int required_output(const RigConfig& c, const ChannelLayout& layout, const std::string& key, const std::string& name) {
+  const int index = layout.output_index(name);
+  if (index < 0) {
+    config_fail(c, key, "unknown output channel '" + name + "' (outputs: " + channel_list(layout.outputs) + ")");
+  }
+  return index;
+}
+
+// The half car's controllers (plant/half_car_params.hpp for the geometry):
+// the body states by their run-file names, the regulated heave from
+// controller.feedback, the two actuator forces from output_1/output_2.
+std::unique_ptr<Controller> make_suspension_controller(const RigConfig& c, const ChannelLayout& layout) {
+  const auto& s = c.controller.suspension;
+  SuspensionChannels ch;
+  ch.z_s = required_input(c, layout, "controller.feedback", c.controller.feedback);
+  auto input = [&](const char* name) {
+    return required_input(c, layout, std::string("controller (body state ") + name + ")", name);
+  };
+  ch.phi = input("phi");
+  ch.z_u1 = input("z_u1");
+  ch.z_u2 = input("z_u2");
+  ch.z_s_dot = input("z_s_dot");
+  ch.z_s_ddot = input("z_s_ddot");
+  ch.phi_dot = input("phi_dot");
+  ch.phi_ddot = input("phi_ddot");
+  ch.z_u1_dot = input("z_u1_dot");
+  ch.z_u2_dot = input("z_u2_dot");
+  ch.output_1 = required_output(c, layout, "controller.output_1", s.output_1);
+  ch.output_2 = required_output(c, layout, "controller.output_2", s.output_2);
+  if (ch.output_1 == ch.output_2) config_fail(c, "controller.output_2", "must differ from output_1");
+  // The output converters must pass the largest force the controller sends.
+  for (const auto& name : {s.output_1, s.output_2}) {
+    const auto it = c.dacs.find(name);
+    if (c.driver == "sim" && it != c.dacs.end() &&
+        (it->second.range_min > -s.force_limit || it->second.range_max < s.force_limit)) {
+      config_fail(c, "controller.force_limit_n", "+-" + std::to_string(s.force_limit) + " N is outside outputs." +
+                                                     name + ".range");
+    }
+  }
+  const LeverArms lever{half_car_lever_arm(c.half_car, 0), half_car_lever_arm(c.half_car, 1)};
+  const auto& type = c.controller.type;
+  try {
+    if (type == "passive") return std::make_unique<PassiveSuspensionController>(ch);
+    if (type == "fuzzy") {
+      FuzzySuspensionConfig f;
+      f.engine = s.fuzzy;
+      f.first_input = s.fuzzy_first_input;
+      f.force_limit = s.force_limit;
+      f.lever_arm = lever;
+      f.channels = ch;
+      return std::make_unique<FuzzySuspensionController>(f);
+    }
+    if (type == "skyhook") {
+      SkyhookConfig k;
+      k.c_sky = s.skyhook_c_sky;
+      k.force_limit = s.force_limit;
+      k.lever_arm = lever;
+      k.channels = ch;
+      return std::make_unique<SkyhookController>(k);
+    }
+    LqrConfig q = LqrConfig::from_design(c.half_car, s.lqr, s.force_limit);
+    q.channels = ch;
+    return std::make_unique<LqrController>(q);
+  } catch (const std::exception& e) {
+    config_fail(c, "controller." + type, e.what());
+  }
+}
+
 std::unique_ptr<Controller> make_controller(const RigConfig& c, const ChannelLayout& layout) {
+  if (c.rig == "half_car") return make_suspension_controller(c, layout);
   const int output = layout.output_index(c.controller.output);
   if (output < 0) {
     config_fail(c, "controller.output", "unknown output channel '" + c.controller.output + "' (outputs: " +
@@ -119,7 +194,9 @@ std::unique_ptr<FilteredProfile> make_profile(const RigConfig& c, double& durati
   const auto& p = c.profile;
   std::unique_ptr<SetpointProfile> raw;
   const LeadIn lead{p.start, p.ramp_target, p.hold_s, p.ramp_rate};
-  if (p.type == "ramp_steps") {
+  if (p.type == "hold") {
+    raw = std::make_unique<HoldProfile>(p.value, p.duration_s);
+  } else if (p.type == "ramp_steps") {
     raw = std::make_unique<RampStepsProfile>(lead, p.steps, p.step_hold_s);
   } else if (p.type == "sine") {
     raw = std::make_unique<SineProfile>(lead, p.amplitude, p.frequency_hz, p.cycles);
@@ -139,6 +216,7 @@ std::unique_ptr<FilteredProfile> make_profile(const RigConfig& c, double& durati
 std::string setpoint_name_for(const std::string& rig) {
   if (rig == "quarter_car") return "x_ref";
   if (rig == "pneumatic_rotary") return "theta_d";
+  if (rig == "half_car") return "z_s_ref";  // body heave demand (0: hold the body at rest)
   return "setpoint";
 }
 

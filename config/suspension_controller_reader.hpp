@@ -1,0 +1,111 @@
+// The half car's config sections beyond the plant: the active-suspension
+// controllers (`controller:`), the passive-vs-active report (`report:`) and
+// the design optimisation (`optimize:`). Strict like the rest of the config:
+// every key required, errors name file, line and key.
+//
+// The fuzzy controller is read as a general Mamdani engine
+// (rt/fuzzy_engine.hpp): two inputs and one output, each with its universe,
+// scale and named membership functions, and the rule base as a table.
+//
+//   fuzzy:
+//     first_input: velocity         # velocity | displacement (what input 1 measures)
+//     resolution: 1001              # output samples for the centroid
+//     inputs:                       # exactly two, in order (file order is kept)
+//       velocity_error:
+//         universe: [-1.0, 1.0]
+//         scale: 10.0               # universe units per physical unit (here 1/(m/s))
+//         sets:
+//           NVL: {trapezoid: [-1.0, -1.0, -0.8, -0.6]}
+//           NL: {triangle: [-0.8, -0.6, -0.4]}
+//           ...
+//       acceleration_error: {...}
+//     output:
+//       force: {universe: [-1, 1], scale: 2000.0, sets: {...}}   # N per universe unit
+//     rules:                        # rows: input-1 sets; one output set per input-2 set,
+//       NVL: "NVL NVL NL"           # in input 2's set order; "-" = no rule
+//       ...
+//
+// A rule "NS: NM NS NS" with input 2's sets N, ZE, P reads: IF x1 is NS AND
+// x2 is N THEN f is NM; IF x1 is NS AND x2 is ZE THEN f is NS; ...
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "config/config_reader.hpp"
+#include "rt/fuzzy_engine.hpp"
+#include "rt/fuzzy_suspension_controller.hpp"
+#include "rt/lqr_controller.hpp"
+#include "rt/suspension_controller.hpp"
+
+namespace rigctl {
+
+// Controller types of the half car, in the order the report runs them.
+inline const std::vector<std::string>& suspension_controller_types() {
+  static const std::vector<std::string> types{"passive", "fuzzy", "skyhook", "lqr"};
+  return types;
+}
+
+struct SuspensionControllerSettings {
+  std::string output_1 = "f_1";  // actuator force outputs (driver output names)
+  std::string output_2 = "f_2";
+  double force_limit = kDefaultSuspensionForceLimit;  // [N] per actuator, every active controller
+  FuzzyEngineSpec fuzzy = paper_fuzzy_spec();
+  FuzzyFirstInput fuzzy_first_input = FuzzyFirstInput::kVelocity;
+  double skyhook_c_sky = 4000.0;  // [N s/m]
+  LqrWeights lqr;
+};
+
+// Reads the half car's `controller:` keys after `type`, `feedback`: output_1,
+// output_2, force_limit_n, fuzzy, skyhook, lqr (all required).
+void read_suspension_controller(ConfigReader& r, SuspensionControllerSettings& s);
+
+// Reads a fuzzy engine section (format above) into a spec; the engine is
+// built once here so that its own checks (unknown set names, unordered
+// points) fail at load with the key named.
+FuzzyEngineSpec read_fuzzy_engine(ConfigReader r, FuzzyFirstInput& first_input);
+
+// `report:` of `rigctl compare`.
+struct SuspensionReportConfig {
+  // Settling band: this fraction of the passive run's peak |z_s|, the same
+  // band for every controller (so they are timed to one standard).
+  double settling_band_fraction = 0.05;
+  double settling_min_band = 0.0;  // [m] floor of the band
+};
+SuspensionReportConfig read_suspension_report(ConfigReader r);
+
+// A design variable of `rigctl optimize`: a HalfCarParams field and its
+// bounds. Names: spring_1, spring_2 [N/m], damper_1, damper_2 [N s/m].
+struct OptimizeVariable {
+  std::string name;
+  double min = 0.0, max = 0.0;
+};
+
+inline const std::vector<std::string>& optimize_variable_names() {
+  static const std::vector<std::string> names{"spring_1", "damper_1", "spring_2", "damper_2"};
+  return names;
+}
+
+// `optimize:` of `rigctl optimize`.
+//   cost = w_comfort Wk/Wk0 + w_tyre T/T0 + w_travel S/S0
+// with Wk the ISO 2631 Wk-weighted RMS body acceleration, T the RMS tyre
+// deflection and S the RMS suspension travel (both corners), each divided by
+// the initial design's value (so the cost of the initial design is the sum
+// of the weights), subject to peak |suspension travel| <= travel_limit.
+struct SuspensionOptimizeConfig {
+  std::string algorithm = "crs2_lm";   // crs2_lm (constraint as a penalty) | isres (constraint native)
+  std::string controller = "passive";  // which controller runs during the search
+  int evaluations = 300;               // simulation runs (the initial design not counted)
+  uint64_t seed = 1;                   // NLopt's random seed: same seed, same search
+  double duration_s = 10.0;            // [s] per evaluation
+  double weight_comfort = 1.0;
+  double weight_tyre = 0.5;
+  double weight_travel = 0.25;
+  double travel_limit = 0.08;          // [m] peak |suspension travel|
+  double penalty = 10.0;               // crs2_lm: cost added per unit of relative constraint violation
+  std::vector<OptimizeVariable> variables;
+};
+SuspensionOptimizeConfig read_suspension_optimize(ConfigReader r);
+
+}  // namespace rigctl

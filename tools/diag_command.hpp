@@ -1,0 +1,24 @@
+// `rigctl diagnose` (shared/spec/measured-data.md section 2).
+#pragma once
+
+#include <ostream>
+#include <string>
+
+namespace rigctl {
+
+struct DiagnoseCommandOptions {
+  std::string rig;
+  std::string data_path;
+  std::string config_path;  // optional
+  std::string json_path;    // optional
+  std::string report_path;  // optional
+  bool drop_bad_rows = false;
+  int decimate = 0;  // 0: the rig's default
+  bool quiet = false;
+};
+
+// Returns the exit code: 0 with a diagnosis (including `none`), 2 for bad
+// input (one-line reason on err), 1 for other failures.
+int run_diagnose(const DiagnoseCommandOptions& options, std::ostream& out, std::ostream& err);
+
+}  // namespace rigctl
