@@ -50,7 +50,7 @@ ControllerConfig read_controller(ConfigReader r, const std::string& rig, double 
     // Passive, the paper's fuzzy controller, or a baseline. Every
     // controller's settings are required: `rigctl compare` runs them all.
     c.type = r.choice("type", suspension_controller_types());
-    c.feedback = r.text("feedback");
+    c.feedback = r.choice("feedback", {"z_s"});  // the regulated body heave (the other body states by their run-file names)
     read_suspension_controller(r, c.suspension);
     c.output = c.suspension.output_1;
     r.reject_unknown_keys();

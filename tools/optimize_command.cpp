@@ -140,6 +140,9 @@ class Problem {
   // constraint at the same point one after the other).
   const DesignEvaluation& evaluate(const std::vector<double>& u) {
     if (have_last_ && u == last_u_) return last_;
+    // CRS2 may try a point or two past maxeval before it checks: the budget
+    // is the configured number of simulations, exactly.
+    if (count_ >= s_.evaluations) throw nlopt::forced_stop();
     last_u_ = u;
     last_ = simulate(physical(u));
     last_.cost = weighted(last_);
@@ -298,6 +301,8 @@ OptimizeResult run_optimize(const OptimizeOptions& options, std::ostream& out, s
   double f = 0.0;
   try {
     result.nlopt_result = result_name(opt.optimize(x, f));
+  } catch (const nlopt::forced_stop&) {
+    result.nlopt_result = result_name(nlopt::MAXEVAL_REACHED);  // our budget, enforced above
   } catch (const std::exception& e) {
     // NLopt ends some searches with an exception (e.g. roundoff limited);
     // the best design found so far stands.
