@@ -21,6 +21,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <optional>
 #include <set>
 #include <thread>
 
@@ -80,56 +81,65 @@ std::vector<std::string> cells(const std::string& a, const std::string& b, const
 // ---------------------------------------------------------------------------
 // Modbus
 
-Json modbus_bench(Context& ctx, Table& table) {
-  const RigConfig config = load_rig_config(ctx.quarter_car_config);
-  if (!config.modbus) return skipped(ctx.quarter_car_config + " has no modbus: section");
-  ModbusDaqConfig server_config = *config.modbus;
-  server_config.connection.transport = ModbusTransport::kTcp;
-  server_config.connection.host = "127.0.0.1";
-  server_config.connection.port = 0;
+// Where the threads run: a loopback round trip is two thread wake-ups, and
+// on this kind of VM a wake-up on the other CPU costs tens of microseconds,
+// so unpinned runs mix two distributions at random. Each comparison is made
+// with both ends on one CPU and with them on different CPUs.
+struct Placement {
+  std::string name;
+  int server_cpu;
+  int client_cpu;
+};
+
+std::vector<Placement> placements() {
+  std::vector<Placement> p = {{"same_cpu", 0, 0}};
+  if (sysconf(_SC_NPROCESSORS_ONLN) > 1) p.push_back({"cross_cpu", 1, 0});
+  return p;
+}
+
+struct ModbusPair {
+  Json json;
+  DistributionSummary driver, bare;
+};
+
+ModbusPair modbus_pair(Context& ctx, const ModbusDaqConfig& server_config, const Placement& where, double seconds) {
+  ModbusPair out;
+  Json& j = out.json;
+  j = Json::object();
+  j["server_cpu"] = where.server_cpu;
+  j["client_cpu"] = where.client_cpu;
   SimModbusDaq server(server_config);
-  server.start();
+  {
+    PinnedScope pin(where.server_cpu);
+    server.start();
+  }
   const ModbusDaqConfig client = server.client_config();
   std::vector<double> inputs(client.inputs.size(), 0.0);
   for (std::size_t i = 0; i < inputs.size(); ++i) inputs[i] = 0.001 * static_cast<double>(i + 1);
   server.set_inputs(inputs.data(), inputs.size());
-
-  const double seconds = ctx.pick(10.0, 1.0);
   const int64_t period_ns = std::llround(client.poll_period_s * 1e9);
   const int64_t cycles = std::llround(seconds / client.poll_period_s);
 
-  Json j = Json::object();
-  j["endpoint"] = client.connection.host + ":" + std::to_string(client.connection.port) + " (SimModbusDaq, loopback)";
-  std::vector<ModbusPoint> in_points, out_points;
-  for (const auto& ch : client.inputs) in_points.push_back(ch.point);
-  for (const auto& ch : client.outputs) out_points.push_back(ch.point);
-  const ReadPlan reads = plan_reads(in_points, {client.max_gap, kMaxReadRegisters});
-  const WritePlan writes = plan_writes(out_points);
-  std::string requests;
-  for (const auto& b : reads.blocks) requests += (requests.empty() ? "" : ", ") + describe_request(false, b.type, b.unit_id, b.address, b.count);
-  for (const auto& b : writes.blocks) requests += ", " + describe_request(true, RegisterType::kHoldingRegister, b.unit_id, b.address, b.count);
-  j["cycle"] = requests;
-  j["period_us"] = period_ns / 1000;
-  j["seconds_each"] = seconds;
-
   // The driver: its I/O thread's own cycle times (ModbusDaq::io_latency).
-  DistributionSummary driver_latency;
   {
     ModbusDaq daq(client);
-    daq.start(2.0);
+    {
+      PinnedScope pin(where.client_cpu);  // the I/O thread starts here and keeps the pin
+      daq.start(2.0);
+    }
     const int64_t start = mono_ns();
     for (int64_t k = 1; k <= cycles && !ctx.stop.load(); ++k) {
       const double u = 0.1 * std::sin(static_cast<double>(k) * 0.01);
       daq.write_outputs(&u, 1);  // what the loop does each tick
       sleep_until_ns(start + k * period_ns);
     }
-    driver_latency = daq.io_latency();
+    out.driver = daq.io_latency();
     const ModbusDaqCounters c = daq.counters();
     daq.stop();
     Json d = Json::object();
     d["what"] = "ModbusDaq I/O thread, one cycle = every planned read + the output write";
     d["scheduling"] = client.io_priority > 0 ? "SCHED_FIFO " + std::to_string(client.io_priority) + " requested" : "normal";
-    d["cycle_time"] = latency_json(driver_latency);
+    d["cycle_time"] = latency_json(out.driver);
     d["timeouts"] = c.timeouts;
     d["protocol_errors"] = c.protocol_errors;
     d["cycle_overruns"] = c.cycle_overruns;
@@ -137,11 +147,17 @@ Json modbus_bench(Context& ctx, Table& table) {
   }
 
   // A bare libmodbus client, same requests, period and priority.
-  DistributionSummary bare_latency;
   {
+    std::vector<ModbusPoint> in_points, out_points;
+    for (const auto& ch : client.inputs) in_points.push_back(ch.point);
+    for (const auto& ch : client.outputs) out_points.push_back(ch.point);
+    const ReadPlan reads = plan_reads(in_points, {client.max_gap, kMaxReadRegisters});
+    const WritePlan writes = plan_writes(out_points);
     Json b = Json::object();
     std::string error;
     int64_t failures = 0;
+    std::optional<PinnedScope> pin;
+    pin.emplace(where.client_cpu);
     std::thread t([&] {
       b["scheduling"] = set_fifo(client.io_priority);
       modbus_t* mb = modbus_new_tcp_pi(client.connection.host.c_str(), std::to_string(client.connection.port).c_str());
@@ -180,7 +196,11 @@ Json modbus_bench(Context& ctx, Table& table) {
         if (ok) {
           hist.record(mono_ns() - t0);
         } else {
+          // The driver's recovery (ModbusLink::drain): a late reply must not
+          // be taken for the next request's, or the client stays one reply
+          // behind for good. Wait out one response timeout, then flush.
           ++failures;
+          sleep_until_ns(mono_ns() + static_cast<int64_t>(timeout_us) * 1000);
           modbus_flush(mb);
         }
         next += period_ns;
@@ -188,25 +208,60 @@ Json modbus_bench(Context& ctx, Table& table) {
       }
       modbus_close(mb);
       modbus_free(mb);
-      bare_latency = hist.summary();
+      out.bare = hist.summary();
     });
+    pin.reset();
     t.join();
     if (!error.empty()) {
       b["status"] = "error";
       b["error"] = error;
     }
     b["what"] = "bare libmodbus client loop (modbus_read_input_registers + modbus_write_register), same plan";
-    b["cycle_time"] = latency_json(bare_latency);
+    b["cycle_time"] = latency_json(out.bare);
     b["failed_cycles"] = failures;
     j["bare_libmodbus"] = b;
   }
   server.stop();
-  j["ratio_driver_over_bare"] = comparison_row(driver_latency, bare_latency);
-  table.row(cells("Modbus TCP cycle", "rigctl driver", driver_latency));
-  table.row(cells("", "bare libmodbus", bare_latency));
-  const Json& r = j["ratio_driver_over_bare"];
+  j["ratio_driver_over_bare"] = comparison_row(out.driver, out.bare);
+  return out;
+}
+
+void ratio_row(Table& table, const Json& r) {
   table.row({"", "ratio", fmt("%.2f", r.find("p50")->number()), fmt("%.2f", r.find("p99")->number()),
              fmt("%.2f", r.find("p999")->number()), fmt("%.2f", r.find("max")->number()), ""});
+}
+
+Json modbus_bench(Context& ctx, Table& table) {
+  const RigConfig config = load_rig_config(ctx.quarter_car_config);
+  if (!config.modbus) return skipped(ctx.quarter_car_config + " has no modbus: section");
+  ModbusDaqConfig server_config = *config.modbus;
+  server_config.connection.transport = ModbusTransport::kTcp;
+  server_config.connection.host = "127.0.0.1";
+  server_config.connection.port = 0;
+  const double seconds = ctx.pick(5.0, 0.5);
+
+  Json j = Json::object();
+  std::vector<ModbusPoint> in_points, out_points;
+  for (const auto& ch : server_config.inputs) in_points.push_back(ch.point);
+  for (const auto& ch : server_config.outputs) out_points.push_back(ch.point);
+  const ReadPlan reads = plan_reads(in_points, {server_config.max_gap, kMaxReadRegisters});
+  const WritePlan writes = plan_writes(out_points);
+  std::string requests;
+  for (const auto& b : reads.blocks) requests += (requests.empty() ? "" : ", ") + describe_request(false, b.type, b.unit_id, b.address, b.count);
+  for (const auto& b : writes.blocks) requests += ", " + describe_request(true, RegisterType::kHoldingRegister, b.unit_id, b.address, b.count);
+  j["server"] = "SimModbusDaq on 127.0.0.1 (normal priority)";
+  j["cycle"] = requests;
+  j["period_us"] = static_cast<int64_t>(std::llround(server_config.poll_period_s * 1e6));
+  j["response_timeout_ms"] = server_config.connection.response_timeout_s * 1e3;
+  j["seconds_each"] = seconds;
+  for (const auto& where : placements()) {
+    if (ctx.stop.load()) break;
+    ModbusPair pair = modbus_pair(ctx, server_config, where, seconds);
+    table.row(cells("Modbus TCP cycle, " + where.name, "rigctl driver", pair.driver));
+    table.row(cells("", "bare libmodbus", pair.bare));
+    ratio_row(table, pair.json["ratio_driver_over_bare"]);
+    j[where.name] = pair.json;
+  }
   j["status"] = "ok";
   return j;
 }
@@ -215,9 +270,11 @@ Json modbus_bench(Context& ctx, Table& table) {
 // CAN over seqpacket
 
 DistributionSummary can_round_trips(Context& ctx, bool through_transport, int64_t frames, int64_t period_ns,
-                                    int64_t& lost) {
+                                    int64_t& lost, const Placement& where) {
   DurationHistogram hist(1000, 20000);
   lost = 0;
+  std::optional<PinnedScope> pin;
+  pin.emplace(where.server_cpu);  // the echo thread starts here
   if (through_transport) {
     auto ends = socketpair_seqpacket();
     CanTransport& a = ends.first;
@@ -233,6 +290,7 @@ DistributionSummary can_round_trips(Context& ctx, bool through_transport, int64_
         }
       }
     });
+    pin.emplace(where.client_cpu);  // and the sender runs here
     int64_t next = mono_ns();
     for (int64_t k = 0; k < frames && !ctx.stop.load(); ++k) {
       canopen::CanFrame f = canopen::make_frame(0x201, {0x0f, 0x00, static_cast<uint8_t>(k), static_cast<uint8_t>(k >> 8)});
@@ -268,6 +326,7 @@ DistributionSummary can_round_trips(Context& ctx, bool through_transport, int64_
         ::send(fd, &f, sizeof f, MSG_DONTWAIT | MSG_NOSIGNAL);
       }
     });
+    pin.emplace(where.client_cpu);
     int64_t next = mono_ns();
     pollfd p{sv[0], POLLIN, 0};
     for (int64_t k = 0; k < frames && !ctx.stop.load(); ++k) {
@@ -294,28 +353,33 @@ DistributionSummary can_round_trips(Context& ctx, bool through_transport, int64_
 }
 
 Json can_bench(Context& ctx, Table& table) {
-  const int64_t frames = ctx.pick<int64_t>(4000, 400);
+  const int64_t frames = ctx.pick<int64_t>(2000, 200);
   const int64_t period_ns = 2'500'000;
   Json j = Json::object();
   j["what"] = "16-byte struct can_frame sent, echoed by a second thread, received; one frame per 2.5 ms; normal priority";
-  j["frames"] = frames;
-  int64_t lost_t = 0, lost_b = 0;
-  const DistributionSummary t = can_round_trips(ctx, true, frames, period_ns, lost_t);
-  const DistributionSummary b = can_round_trips(ctx, false, frames, period_ns, lost_b);
-  Json tj = Json::object();
-  tj["round_trip"] = latency_json(t);
-  tj["lost"] = lost_t;
-  j["can_transport"] = tj;
-  Json bj = Json::object();
-  bj["round_trip"] = latency_json(b);
-  bj["lost"] = lost_b;
-  j["bare_socketpair"] = bj;
-  j["ratio_transport_over_bare"] = comparison_row(t, b);
-  table.row(cells("CAN frame round trip", "CanTransport (seqpacket)", t));
-  table.row(cells("", "bare socketpair", b));
-  const Json& r = j["ratio_transport_over_bare"];
-  table.row({"", "ratio", fmt("%.2f", r.find("p50")->number()), fmt("%.2f", r.find("p99")->number()),
-             fmt("%.2f", r.find("p999")->number()), fmt("%.2f", r.find("max")->number()), ""});
+  j["frames_each"] = frames;
+  for (const auto& where : placements()) {
+    if (ctx.stop.load()) break;
+    int64_t lost_t = 0, lost_b = 0;
+    const DistributionSummary t = can_round_trips(ctx, true, frames, period_ns, lost_t, where);
+    const DistributionSummary b = can_round_trips(ctx, false, frames, period_ns, lost_b, where);
+    Json p = Json::object();
+    p["echo_cpu"] = where.server_cpu;
+    p["sender_cpu"] = where.client_cpu;
+    Json tj = Json::object();
+    tj["round_trip"] = latency_json(t);
+    tj["lost"] = lost_t;
+    p["can_transport"] = tj;
+    Json bj = Json::object();
+    bj["round_trip"] = latency_json(b);
+    bj["lost"] = lost_b;
+    p["bare_socketpair"] = bj;
+    p["ratio_transport_over_bare"] = comparison_row(t, b);
+    table.row(cells("CAN frame round trip, " + where.name, "CanTransport (seqpacket)", t));
+    table.row(cells("", "bare socketpair", b));
+    ratio_row(table, p["ratio_transport_over_bare"]);
+    j[where.name] = p;
+  }
   j["status"] = "ok";
   return j;
 }
@@ -539,6 +603,11 @@ Json lcm_bench(Context& ctx, Table& lcm_table) {
 Section io_section() {
   return {"io", "io: Modbus TCP and CAN round trips against bare clients, LCM udpm throughput and loss", [](Context& ctx) {
             Json j = Json::object();
+            // As during a run (rt/realtime.cpp): no deep idle states, whose
+            // exit latency would dominate every wake-up measured here.
+            const DmaLatencyHold dma;
+            j["cpu_dma_latency"] = dma.held() ? "held at 0 us" : "not held: " + dma.reason();
+            ctx.out << "  cpu_dma_latency " << (dma.held() ? "held at 0 us" : "not held (" + dma.reason() + ")") << "\n";
             Table table({"path", "client", "p50 us", "p99 us", "p99.9 us", "max us", "count"});
             auto guarded = [&](const char* name, auto&& fn) {
               try {

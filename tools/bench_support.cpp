@@ -252,6 +252,53 @@ std::string realtime_refusal(int priority) {
   return reason;
 }
 
+PinnedScope::PinnedScope(int cpu) {
+  if (pthread_getaffinity_np(pthread_self(), sizeof saved_, &saved_) != 0) return;
+  cpu_set_t one;
+  CPU_ZERO(&one);
+  CPU_SET(cpu, &one);
+  pinned_ = pthread_setaffinity_np(pthread_self(), sizeof one, &one) == 0;
+}
+
+PinnedScope::~PinnedScope() {
+  if (pinned_) pthread_setaffinity_np(pthread_self(), sizeof saved_, &saved_);
+}
+
+DmaLatencyHold::DmaLatencyHold() {
+  fd_ = ::open("/dev/cpu_dma_latency", O_WRONLY | O_CLOEXEC);
+  const int32_t zero = 0;
+  if (fd_ < 0 || ::write(fd_, &zero, sizeof zero) != sizeof zero) {
+    reason_ = std::string("/dev/cpu_dma_latency: ") + std::strerror(errno);
+    if (fd_ >= 0) ::close(fd_);
+    fd_ = -1;
+  }
+}
+
+DmaLatencyHold::~DmaLatencyHold() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+CpuTimes read_cpu_times() {
+  std::ifstream in("/proc/stat");
+  std::string cpu;
+  in >> cpu;
+  CpuTimes t;
+  if (cpu != "cpu") return t;
+  // user nice system idle iowait irq softirq steal (guest times are inside user)
+  for (int i = 0; i < 8; ++i) {
+    uint64_t v = 0;
+    if (!(in >> v)) break;
+    t.total += v;
+    if (i == 7) t.steal = v;
+  }
+  return t;
+}
+
+double steal_fraction(const CpuTimes& before, const CpuTimes& after) {
+  if (after.total <= before.total) return std::numeric_limits<double>::quiet_NaN();
+  return static_cast<double>(after.steal - before.steal) / static_cast<double>(after.total - before.total);
+}
+
 std::string Table::text(const std::string& indent) const {
   std::vector<std::size_t> width;
   for (const auto& r : rows_) {

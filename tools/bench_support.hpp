@@ -3,6 +3,8 @@
 // facts about the machine, and a scratch directory.
 #pragma once
 
+#include <sched.h>
+
 #include <atomic>
 #include <cstdint>
 #include <string>
@@ -72,6 +74,47 @@ double load_average_1min();
 // "" when the calling process may give a thread SCHED_FIFO at `priority`
 // (checked on a short-lived thread), else the reason.
 std::string realtime_refusal(int priority);
+
+// Pins the calling thread to one CPU until destroyed (then restores its
+// mask). Threads started meanwhile inherit the pin: that is how the I/O
+// benchmarks place a server and a client on the same or on different CPUs.
+class PinnedScope {
+ public:
+  explicit PinnedScope(int cpu);
+  ~PinnedScope();
+  PinnedScope(const PinnedScope&) = delete;
+  PinnedScope& operator=(const PinnedScope&) = delete;
+  bool pinned() const { return pinned_; }
+
+ private:
+  bool pinned_ = false;
+  cpu_set_t saved_{};
+};
+
+// Holds /dev/cpu_dma_latency at 0 (no deep CPU idle states) until destroyed,
+// as the loop's real-time set-up does while it runs.
+class DmaLatencyHold {
+ public:
+  DmaLatencyHold();
+  ~DmaLatencyHold();
+  DmaLatencyHold(const DmaLatencyHold&) = delete;
+  DmaLatencyHold& operator=(const DmaLatencyHold&) = delete;
+  bool held() const { return fd_ >= 0; }
+  const std::string& reason() const { return reason_; }
+
+ private:
+  int fd_ = -1;
+  std::string reason_;
+};
+
+// Cumulative CPU time of the whole machine (/proc/stat), for the share the
+// hypervisor took away (steal) while something ran.
+struct CpuTimes {
+  uint64_t total = 0, steal = 0;
+};
+CpuTimes read_cpu_times();
+// steal / total between two readings, or NaN.
+double steal_fraction(const CpuTimes& before, const CpuTimes& after);
 
 // A console table: columns padded to their widest cell, first column left
 // aligned, the others right aligned.

@@ -173,7 +173,7 @@ Section timing_section() {
                     << (fifo ? "SCHED_FIFO " + std::to_string(rt.priority) : "best effort (" + refusal + ")")
                     << ", cpu_dma_latency " << (rt.hold_cpu_dma_latency ? "held at 0" : "not held") << "\n";
 
-            Table latency({"condition", "source", "p50 us", "p99 us", "p99.9 us", "max us", "overruns"});
+            Table latency({"condition", "source", "p50 us", "p99 us", "p99.9 us", "max us", "overruns", "steal %"});
             Table compute({"condition", "compute p50 us", "p99 us", "max us", "p50/period", "p99/period", "max/period"});
             for (const std::string condition : {"idle", "load"}) {
               if (ctx.stop.load()) break;
@@ -186,7 +186,9 @@ Section timing_section() {
               }
               c["load_average_1min_before"] = load_average_1min();
 
+              const CpuTimes loop_before = read_cpu_times();
               const LoopRun loop = run_loop(ctx, seconds, condition);
+              const double loop_steal = steal_fraction(loop_before, read_cpu_times());
               const TimingSummary& t = loop.timing;
               Json l = Json::object();
               l["wakeup_latency"] = latency_json(t.wakeup_latency);
@@ -195,10 +197,12 @@ Section timing_section() {
               l["ticks"] = t.ticks;
               l["overruns"] = t.overruns;
               l["missed_ticks"] = t.missed_ticks;
+              l["cpu_steal_fraction"] = loop_steal;
               c["rigctl"] = l;
               std::vector<std::string> row = {condition, "rigctl loop"};
               for (auto& cell : latency_cells(t.wakeup_latency)) row.push_back(cell);
               row.push_back(std::to_string(t.overruns));
+              row.push_back(fmt("%.1f", 100.0 * loop_steal));
               latency.row(row);
               compute.row({condition, fmt("%.1f", t.compute.p50_ns / 1e3), fmt("%.1f", t.compute.p99_ns / 1e3),
                            fmt("%.1f", t.compute.max_ns / 1e3),
@@ -207,12 +211,17 @@ Section timing_section() {
                            fmt("%.2f%%", 100.0 * ratio(t.compute.max_ns, period_ns))});
 
               if (!ctx.stop.load()) {
+                const CpuTimes ct_before = read_cpu_times();
                 const CyclictestRun ct = run_cyclictest(ctx, rt, fifo, period_us, loops, condition);
+                const double ct_steal = steal_fraction(ct_before, read_cpu_times());
                 c["cyclictest"] = ct.json;
+                c["cyclictest"]["cpu_steal_fraction"] = ct_steal;
                 if (ct.latency) {
                   const DistributionSummary& k = *ct.latency;
                   std::vector<std::string> krow = {condition, "cyclictest"};
                   for (auto& cell : latency_cells(k)) krow.push_back(cell);
+                  krow.push_back("");
+                  krow.push_back(fmt("%.1f", 100.0 * ct_steal));
                   latency.row(krow);
                   Json r = Json::object();
                   r["p50"] = ratio(t.wakeup_latency.p50_ns, k.p50_ns);
@@ -232,7 +241,7 @@ Section timing_section() {
               c["load_average_1min_after"] = load_average_1min();
               j[condition] = c;
             }
-            ctx.out << "  wake-up latency (time past the deadline):\n" << latency.text("    ")
+            ctx.out << "  wake-up latency (time past the deadline; steal: CPU time the hypervisor took during the run):\n" << latency.text("    ")
                     << "  compute per tick (read to write; period " << period_us << " us):\n" << compute.text("    ");
             return j;
           }};
