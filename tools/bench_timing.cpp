@@ -77,15 +77,17 @@ CyclictestRun run_cyclictest(Context& ctx, const RealtimeConfig& rt, bool fifo, 
     r.json = skipped("cyclictest not found: install Debian package rt-tests");
     return r;
   }
+  if (!fifo) {
+    // cyclictest refuses to run without the right to real-time scheduling,
+    // whatever --policy says.
+    r.json = skipped("cyclictest needs SCHED_FIFO, which this process may not use (run as root)");
+    return r;
+  }
   const std::string hist = ctx.scratch.file("cyclictest-" + tag + ".hist");
   std::vector<std::string> argv = {"cyclictest", "-m", "-q", "-t", "1", "-i", std::to_string(period_us),
                                    "-l", std::to_string(loops), "-h", std::to_string(2 * period_us),
                                    "--histfile=" + hist};
-  if (fifo) {
-    argv.insert(argv.end(), {"--policy=fifo", "-p", std::to_string(rt.priority)});
-  } else {
-    argv.insert(argv.end(), {"--policy=other"});
-  }
+  argv.insert(argv.end(), {"--policy=fifo", "-p", std::to_string(rt.priority)});
   if (rt.cpu >= 0) argv.insert(argv.end(), {"-a", std::to_string(rt.cpu)});
   if (!rt.hold_cpu_dma_latency) argv.push_back("--default-system");
   std::string command;
@@ -171,7 +173,7 @@ Section timing_section() {
             j["order"] = "per condition: rigctl loop, then cyclictest";
             ctx.out << "  " << seconds << " s each at " << period_us << " us, "
                     << (fifo ? "SCHED_FIFO " + std::to_string(rt.priority) : "best effort (" + refusal + ")")
-                    << ", cpu_dma_latency " << (rt.hold_cpu_dma_latency ? "held at 0" : "not held") << "\n";
+                    << (rt.hold_cpu_dma_latency ? ", cpu_dma_latency held at 0 (as configured)" : "") << "\n";
 
             Table latency({"condition", "source", "p50 us", "p99 us", "p99.9 us", "max us", "overruns", "steal %"});
             Table compute({"condition", "compute p50 us", "p99 us", "max us", "p50/period", "p99/period", "max/period"});
