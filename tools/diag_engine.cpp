@@ -1,3 +1,4 @@
+#include "tools/json_text.hpp"
 #include "tools/diag_engine.hpp"
 
 #include <algorithm>
@@ -487,39 +488,11 @@ Diagnosis diagnose(const RigModel& model, const DiagnoseOptions& opt) {
 
 namespace {
 
-std::string json_str(const std::string& s) {
-  std::string o = "\"";
-  for (char c : s) {
-    switch (c) {
-      case '"': o += "\\\""; break;
-      case '\\': o += "\\\\"; break;
-      case '\n': o += "\\n"; break;
-      case '\t': o += "\\t"; break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04x", c);
-          o += buf;
-        } else {
-          o += c;
-        }
-    }
-  }
-  return o + "\"";
-}
-
-std::string json_num(double v) {
-  if (!std::isfinite(v)) return "null";
-  std::ostringstream os;
-  os << std::setprecision(10) << v;
-  return os.str();
-}
-
 std::string json_fit_map(const std::map<std::string, double>& m) {
   std::string s = "{";
   bool first = true;
   for (const auto& [k, v] : m) {
-    s += (first ? "" : ", ") + json_str(k) + ": " + json_num(v);
+    s += (first ? "" : ", ") + json_string(k) + ": " + json_number(v);
     first = false;
   }
   return s + "}";
@@ -528,47 +501,47 @@ std::string json_fit_map(const std::map<std::string, double>& m) {
 }  // namespace
 
 void write_json(const Diagnosis& d, std::ostream& out) {
-  out << "{\n  \"rig\": " << json_str(d.rig) << ",\n  \"cause\": " << json_str(d.cause) << ",\n  \"causes\": [";
+  out << "{\n  \"rig\": " << json_string(d.rig) << ",\n  \"cause\": " << json_string(d.cause) << ",\n  \"causes\": [";
   for (std::size_t i = 0; i < d.causes.size(); ++i) {
     const auto& c = d.causes[i];
-    out << (i ? ",\n" : "\n") << "    {\"cause\": " << json_str(c.cause) << ", \"confidence\": " << json_num(c.confidence)
-        << ",\n     \"evidence\": " << json_str(c.evidence) << ",\n     \"parameters\": {";
+    out << (i ? ",\n" : "\n") << "    {\"cause\": " << json_string(c.cause) << ", \"confidence\": " << json_number(c.confidence)
+        << ",\n     \"evidence\": " << json_string(c.evidence) << ",\n     \"parameters\": {";
     for (std::size_t j = 0; j < c.parameters.size(); ++j)
-      out << (j ? ", " : "") << json_str(c.parameters[j].name) << ": " << json_num(c.parameters[j].value);
+      out << (j ? ", " : "") << json_string(c.parameters[j].name) << ": " << json_number(c.parameters[j].value);
     out << "},\n     \"parameter_sigma\": {";
     for (std::size_t j = 0; j < c.parameters.size(); ++j)
-      out << (j ? ", " : "") << json_str(c.parameters[j].name) << ": " << json_num(c.parameters[j].sigma);
+      out << (j ? ", " : "") << json_string(c.parameters[j].name) << ": " << json_number(c.parameters[j].sigma);
     out << "},\n     \"parameter_units\": {";
     for (std::size_t j = 0; j < c.parameters.size(); ++j)
-      out << (j ? ", " : "") << json_str(c.parameters[j].name) << ": " << json_str(c.parameters[j].unit);
-    out << "},\n     \"baseline_fit_percent\": " << json_num(c.baseline_fit_percent)
-        << ", \"extended_fit_percent\": " << json_num(c.extended_fit_percent)
-        << ", \"gain_percent_points\": " << json_num(c.gain_percent_points) << ", \"signal\": " << json_str(c.signal)
+      out << (j ? ", " : "") << json_string(c.parameters[j].name) << ": " << json_string(c.parameters[j].unit);
+    out << "},\n     \"baseline_fit_percent\": " << json_number(c.baseline_fit_percent)
+        << ", \"extended_fit_percent\": " << json_number(c.extended_fit_percent)
+        << ", \"gain_percent_points\": " << json_number(c.gain_percent_points) << ", \"signal\": " << json_string(c.signal)
         << "}";
   }
   out << (d.causes.empty() ? "],\n" : "\n  ],\n");
   out << "  \"baseline_fit_percent\": " << json_fit_map(d.baseline_fit_percent) << ",\n";
   out << "  \"extended_fit_percent\": " << json_fit_map(d.extended_fit_percent) << ",\n";
-  out << "  \"validation\": " << json_str(d.validation) << ",\n";
+  out << "  \"validation\": " << json_string(d.validation) << ",\n";
   out << "  \"baseline_parameters\": {";
   for (std::size_t j = 0; j < d.baseline_parameters.size(); ++j)
-    out << (j ? ", " : "") << json_str(d.baseline_parameters[j].name) << ": " << json_num(d.baseline_parameters[j].value);
+    out << (j ? ", " : "") << json_string(d.baseline_parameters[j].name) << ": " << json_number(d.baseline_parameters[j].value);
   out << "},\n  \"final_parameters\": {";
   for (std::size_t j = 0; j < d.final_parameters.size(); ++j)
-    out << (j ? ", " : "") << json_str(d.final_parameters[j].name) << ": " << json_num(d.final_parameters[j].value);
+    out << (j ? ", " : "") << json_string(d.final_parameters[j].name) << ": " << json_number(d.final_parameters[j].value);
   out << "},\n  \"screened\": [";
   for (std::size_t j = 0; j < d.screened.size(); ++j) {
     const auto& s = d.screened[j];
-    out << (j ? ",\n" : "\n") << "    {\"round\": " << s.round << ", \"cause\": " << json_str(s.cause)
-        << ", \"estimation_cost\": " << json_num(s.estimation_cost) << ", \"refitted\": " << (s.refitted ? "true" : "false");
+    out << (j ? ",\n" : "\n") << "    {\"round\": " << s.round << ", \"cause\": " << json_string(s.cause)
+        << ", \"estimation_cost\": " << json_number(s.estimation_cost) << ", \"refitted\": " << (s.refitted ? "true" : "false");
     if (s.refitted)
-      out << ", \"gain_percent_points\": " << json_num(s.gain_percent_points) << ", \"signal\": " << json_str(s.signal);
-    out << ", \"accepted\": " << (s.accepted ? "true" : "false") << ", \"reason\": " << json_str(s.reason) << "}";
+      out << ", \"gain_percent_points\": " << json_number(s.gain_percent_points) << ", \"signal\": " << json_string(s.signal);
+    out << ", \"accepted\": " << (s.accepted ? "true" : "false") << ", \"reason\": " << json_string(s.reason) << "}";
   }
   out << (d.screened.empty() ? "],\n" : "\n  ],\n");
   out << "  \"not_implemented_candidates\": [";
-  for (std::size_t j = 0; j < d.stubs.size(); ++j) out << (j ? ", " : "") << json_str(d.stubs[j]);
-  out << "],\n  \"elapsed_s\": " << json_num(d.elapsed_s) << "\n}\n";
+  for (std::size_t j = 0; j < d.stubs.size(); ++j) out << (j ? ", " : "") << json_string(d.stubs[j]);
+  out << "],\n  \"elapsed_s\": " << json_number(d.elapsed_s) << "\n}\n";
 }
 
 // ---------------------------------------------------------------- HTML report

@@ -1,3 +1,4 @@
+#include "tools/json_text.hpp"
 #include "tools/optimize_command.hpp"
 
 #include <unistd.h>
@@ -65,22 +66,6 @@ std::string result_name(nlopt::result r) {
     case nlopt::MAXTIME_REACHED: return "MAXTIME_REACHED";
     default: return "UNKNOWN";
   }
-}
-
-std::string json_number(double v) {
-  if (!std::isfinite(v)) return "null";
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.9g", v + 0.0);
-  return buf;
-}
-
-std::string json_string(const std::string& s) {
-  std::string out = "\"";
-  for (char ch : s) {
-    if (ch == '"' || ch == '\\') out += '\\';
-    out += ch;
-  }
-  return out + "\"";
 }
 
 class Problem {
