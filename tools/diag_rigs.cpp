@@ -10,63 +10,12 @@
 #include "plant/bearing_friction.hpp"
 #include "plant/quarter_car_params.hpp"
 #include "tools/diag_model.hpp"
+#include "tools/diag_rigs.hpp"
+#include "tools/diag_util.hpp"
 
 namespace rigctl::diag {
 
 namespace {
-
-std::vector<double> central_diff(const std::vector<double>& x, double dt) {
-  const std::size_t n = x.size();
-  std::vector<double> v(n, 0.0);
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t a = i == 0 ? 0 : i - 1, b = i + 1 < n ? i + 1 : n - 1;
-    v[i] = b > a ? (x[b] - x[a]) / (static_cast<double>(b - a) * dt) : 0.0;
-  }
-  return v;
-}
-
-// Value of a uniformly sampled series at fractional sample position s (clamped).
-double at(const std::vector<double>& y, double s) {
-  if (s <= 0.0) return y.front();
-  const double last = static_cast<double>(y.size() - 1);
-  if (s >= last) return y.back();
-  const auto i = static_cast<std::size_t>(s);
-  const double a = s - static_cast<double>(i);
-  return y[i] + a * (y[i + 1] - y[i]);
-}
-
-// Delays a series by tau (linear interpolation), holding the first value before the start.
-void delay(std::vector<double>& y, double tau, double dt) {
-  if (tau <= 0.0) return;
-  const std::vector<double> src = y;
-  const double shift = tau / dt;
-  for (std::size_t i = 0; i < y.size(); ++i) y[i] = at(src, static_cast<double>(i) - shift);
-}
-
-// Implicit (Moreau) velocity update of a mass with viscous and Coulomb
-// friction under force f over a step h: sticks exactly, never chatters.
-// cp, cn >= 0: Coulomb levels for positive and negative motion; dp, dn >= 0 viscous.
-double implicit_velocity(double m, double v, double f, double h, double cp, double cn, double dp, double dn) {
-  const double a = m * v + h * f;
-  if (a > h * cp) return (a - h * cp) / (m + h * dp);
-  if (a < -h * cn) return (a + h * cn) / (m + h * dn);
-  return 0.0;
-}
-
-ParamSpec P(const std::string& name, const std::string& unit, double init, double lo, double hi, double scale,
-            double null = 0.0, bool strength = false, std::vector<double> starts = {}) {
-  ParamSpec p;
-  p.name = name;
-  p.unit = unit;
-  p.init = init;
-  p.lo = lo;
-  p.hi = hi;
-  p.scale = scale;
-  p.null = null;
-  p.strength = strength;
-  p.starts = std::move(starts);
-  return p;
-}
 
 // ------------------------------------------------------------------ linear_axis
 
@@ -447,8 +396,9 @@ std::unique_ptr<RigModel> make_rig_model(const std::string& rig, const RunFile& 
   if (rig == "linear_axis") return std::make_unique<LinearAxisModel>(run, o);
   if (rig == "damper") return std::make_unique<DamperModel>(run, o);
   if (rig == "quarter_car") return std::make_unique<QuarterCarModel>(run, o);
-  if (rig == "pneumatic_rotary" || rig == "half_car")
-    throw RunFileError("diagnosis of rig kind '" + rig + "' is not implemented yet (linear_axis, damper, quarter_car are)");
+  if (rig == "pneumatic_rotary") return make_pneumatic_rotary_model(run, o);
+  if (rig == "half_car")
+    throw RunFileError("diagnosis of rig kind '" + rig + "' is not implemented yet (linear_axis, damper, quarter_car, pneumatic_rotary are)");
   throw RunFileError("unknown rig kind '" + rig + "'");
 }
 

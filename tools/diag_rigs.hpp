@@ -1,0 +1,15 @@
+// Per-rig factories of the diagnosis sub-models; make_rig_model (diag_model.hpp)
+// dispatches on the rig kind. One file per rig kind where it grows large.
+#pragma once
+
+#include <memory>
+
+#include "tools/diag_model.hpp"
+
+namespace rigctl::diag {
+
+// tools/diag_pneumatic.cpp: closed-loop replay of theta_d through the P+V+dP
+// controller and the pneumatic rotary plant (seed 002).
+std::unique_ptr<RigModel> make_pneumatic_rotary_model(const RunFile& run, const RigModelOptions& options);
+
+}  // namespace rigctl::diag
