@@ -397,8 +397,7 @@ std::unique_ptr<RigModel> make_rig_model(const std::string& rig, const RunFile& 
   if (rig == "damper") return std::make_unique<DamperModel>(run, o);
   if (rig == "quarter_car") return std::make_unique<QuarterCarModel>(run, o);
   if (rig == "pneumatic_rotary") return make_pneumatic_rotary_model(run, o);
-  if (rig == "half_car")
-    throw RunFileError("diagnosis of rig kind '" + rig + "' is not implemented yet (linear_axis, damper, quarter_car, pneumatic_rotary are)");
+  if (rig == "half_car") return make_half_car_model(run, o);
   throw RunFileError("unknown rig kind '" + rig + "'");
 }
 

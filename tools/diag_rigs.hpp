@@ -11,5 +11,8 @@ namespace rigctl::diag {
 // tools/diag_pneumatic.cpp: closed-loop replay of theta_d through the P+V+dP
 // controller and the pneumatic rotary plant (seed 002).
 std::unique_ptr<RigModel> make_pneumatic_rotary_model(const RunFile& run, const RigModelOptions& options);
+// tools/diag_half_car.cpp: the 4-DOF half car (seed 001) driven by the
+// measured road and actuator forces.
+std::unique_ptr<RigModel> make_half_car_model(const RunFile& run, const RigModelOptions& options);
 
 }  // namespace rigctl::diag

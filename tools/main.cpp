@@ -9,6 +9,7 @@
 #include "config/config_reader.hpp"
 #include "tools/bench_command.hpp"
 #include "tools/diag_command.hpp"
+#include "tools/hidden_effects.hpp"
 #include "tools/log2csv.hpp"
 #include "tools/optimize_command.hpp"
 #include "tools/rig_sim.hpp"
@@ -99,6 +100,18 @@ int main(int argc, char** argv) {
   diag_cmd->add_option("--decimate", diag.decimate, "Keep every Nth sample (default: the rig's choice)");
   diag_cmd->add_flag("--quiet", diag.quiet, "No progress on stderr");
 
+  rigctl::MakeRunOptions make;
+  std::vector<std::string> effect_texts;
+  auto* make_cmd = app.add_subcommand("make-run", "Hidden-effect generator: a run file from the simulated closed loop with chosen effects switched on (diagnosis tests)");
+  make_cmd->add_option("--rig", make.rig, "Rig kind: quarter_car, pneumatic_rotary, half_car")->required();
+  make_cmd->add_option("--config", make.config_path, "Rig config (default: config/<rig>.yaml)");
+  make_cmd->add_option("--case", make.case_name, "Excitation case of the config (default: the rig's diagnosis case)");
+  make_cmd->add_option("--effect", effect_texts, "CAUSE[:weak|strong|LEVEL], repeatable; none or absent: a clean run");
+  make_cmd->add_option("--duration", make.duration_s, "Run length [s] (default: the profile's)");
+  make_cmd->add_option("--seed", make.seed, "Sensor-noise seed");
+  make_cmd->add_option("--out", make.out_csv, "Run file to write (CSV)")->required();
+  make_cmd->add_option("--truth", make.truth_json, "Write what was hidden (JSON)");
+
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -122,6 +135,15 @@ int main(int argc, char** argv) {
     if (optimize_cmd->parsed()) {
       if (evaluations_opt->count() > 0) optimize.evaluations = optimize_evaluations;
       rigctl::run_optimize(optimize, std::cout, std::cerr);
+      return 0;
+    }
+    if (make_cmd->parsed()) {
+      for (const auto& e : effect_texts) {
+        const auto colon = e.find(':');
+        make.effects.emplace_back(e.substr(0, colon),
+                                  colon == std::string::npos ? 1.0 : rigctl::parse_effect_level(e.substr(colon + 1)));
+      }
+      rigctl::make_run(make, std::cerr);
       return 0;
     }
     if (bench_cmd->parsed()) {

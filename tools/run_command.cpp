@@ -50,7 +50,10 @@ std::string describe(const DistributionSummary& d) {
 }  // namespace
 
 RunReport run_rig(const RunOptions& options, const std::atomic<bool>& stop, std::ostream& out) {
-  const RigConfig config = load_rig_config(options.config_path, options.case_name);
+  return run_rig(load_rig_config(options.config_path, options.case_name), options, stop, out);
+}
+
+RunReport run_rig(const RigConfig& config, const RunOptions& options, const std::atomic<bool>& stop, std::ostream& out) {
   AssembledRig rig = assemble_rig(config);
   if (options.fast && !rig.driver->simulated()) {
     throw std::runtime_error("--fast needs a simulated driver: '" + config.driver + "' runs real hardware in real time");

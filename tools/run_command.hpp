@@ -7,6 +7,7 @@
 #include <ostream>
 #include <string>
 
+#include "config/rig_config.hpp"
 #include "rt/rig_loop.hpp"
 
 namespace rigctl {
@@ -32,5 +33,8 @@ struct RunReport {
 // Throws ConfigError or std::runtime_error with a clear message; `stop`
 // ends the run early (signal handlers set it).
 RunReport run_rig(const RunOptions& options, const std::atomic<bool>& stop, std::ostream& out);
+// The same with a config already loaded (and possibly edited: the hidden-effect
+// generator); options.config_path and case_name are then only reported.
+RunReport run_rig(const RigConfig& config, const RunOptions& options, const std::atomic<bool>& stop, std::ostream& out);
 
 }  // namespace rigctl
