@@ -12,6 +12,10 @@ struct SensorSpec {
   double range_min = 0.0;  // [SI] ADC full scale; used when bits > 0
   double range_max = 0.0;
   double offset = 0.0;     // [SI] added to the true value
+  // [s] transport delay of the transducer and its filter; the simulated
+  // driver interpolates a history of the true signal (cubic, so that it is
+  // not the linear interpolation the diagnosis fits). 0 = none.
+  double delay_s = 0.0;
 };
 
 class SensorModel {
