@@ -26,6 +26,7 @@ class SensorModel {
   // whole run reproducible.
   double measure(double truth, std::mt19937_64& rng) const noexcept;
   double lsb() const noexcept { return lsb_; }
+  double delay_s() const noexcept { return spec_.delay_s; }
 
  private:
   SensorSpec spec_;

@@ -15,7 +15,11 @@ SimDriver::SimDriver(std::unique_ptr<SimulatedPlant> plant, std::vector<SensorSp
   if (sensors.size() != layout_.inputs.size()) throw std::invalid_argument("one sensor spec per plant signal is needed");
   if (safe_command_.size() != layout_.outputs.size()) throw std::invalid_argument("safe command size differs from outputs");
   if (dacs.size() != layout_.outputs.size()) throw std::invalid_argument("one DAC spec per plant command is needed");
-  for (const auto& s : sensors) sensors_.emplace_back(s);
+  for (const auto& s : sensors) {
+    if (!(s.delay_s >= 0.0)) throw std::invalid_argument("sensor delay must be >= 0 s");
+    sensors_.emplace_back(s);
+    delays_.emplace_back(s.delay_s, period_s);
+  }
   for (auto d : dacs) {
     d.noise_sd = 0.0;  // a DAC quantises and clips; its noise belongs to the plant
     dacs_.emplace_back(d);
@@ -28,6 +32,7 @@ void SimDriver::start() {
   plant_->reset();
   rng_.seed(seed_);
   command_ = safe_command_;
+  for (std::size_t i = 0; i < delays_.size(); ++i) delays_[i] = DelayLine(sensors_[i].delay_s(), period_s_);
   tick_ = 0;
   started_ = false;
 }
@@ -43,7 +48,10 @@ bool SimDriver::read(Sample& out) {
   plant_->measure(truth_);
   out.t_ns = tick_ * period_ns_;
   out.status = 0;
-  for (std::size_t i = 0; i < truth_.size(); ++i) out.value[i] = sensors_[i].measure(truth_[i], rng_);
+  for (std::size_t i = 0; i < truth_.size(); ++i) {
+    const double seen = delays_[i].active() ? delays_[i].push(truth_[i]) : truth_[i];
+    out.value[i] = sensors_[i].measure(seen, rng_);
+  }
   return true;
 }
 

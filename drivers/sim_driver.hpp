@@ -8,6 +8,7 @@
 #include <random>
 #include <vector>
 
+#include "drivers/delay_line.hpp"
 #include "drivers/driver.hpp"
 #include "drivers/sensor_model.hpp"
 #include "plant/simulated_plant.hpp"
@@ -36,6 +37,7 @@ class SimDriver final : public Driver {
  private:
   std::unique_ptr<SimulatedPlant> plant_;
   std::vector<SensorModel> sensors_;
+  std::vector<DelayLine> delays_;  // per signal; inactive where the spec has no delay
   std::vector<SensorModel> dacs_;
   ChannelLayout layout_;
   double period_s_;
