@@ -27,6 +27,17 @@ const char* kind_name(const YAML::Node& n) {
     default: return "undefined";
   }
 }
+
+// A mapping key as text. YAML allows a list or a mapping as a key
+// (`? [a, b] : 1`); config keys are names, so that is a config error rather
+// than yaml-cpp's BadConversion escaping (found by tests/fuzz/fuzz_config).
+std::string key_text(const YAML::Node& key, const std::string& file, const std::string& path) {
+  if (key.IsMap() || key.IsSequence()) {
+    throw ConfigError(file + ":" + std::to_string(key.Mark().line + 1) + ": " + (path.empty() ? "" : path + ": ") +
+                      "expected a key name, got " + kind_name(key));
+  }
+  return key.as<std::string>();
+}
 }  // namespace
 
 ConfigReader::ConfigReader(YAML::Node node, std::shared_ptr<const std::string> file, std::string path)
@@ -34,12 +45,12 @@ ConfigReader::ConfigReader(YAML::Node node, std::shared_ptr<const std::string> f
       used_(std::make_shared<std::set<std::string>>()) {}
 
 namespace {
-void merge_into(YAML::Node target, const YAML::Node& overlay) {
+void merge_into(YAML::Node target, const YAML::Node& overlay, const std::string& file) {
   for (const auto& kv : overlay) {
-    const auto key = kv.first.as<std::string>();
+    const auto key = key_text(kv.first, file, "cases");
     YAML::Node existing = target[key];
     if (kv.second.IsMap() && existing.IsMap()) {
-      merge_into(existing, kv.second);
+      merge_into(existing, kv.second, file);
     } else {
       target[key] = YAML::Clone(kv.second);
     }
@@ -67,7 +78,7 @@ ConfigReader ConfigReader::from_root(YAML::Node root, const std::string& name, c
     if (!cases.IsDefined() || !cases[case_name].IsDefined()) {
       std::string known;
       if (cases.IsDefined()) {
-        for (const auto& kv : cases) known += (known.empty() ? "" : ", ") + kv.first.as<std::string>();
+        for (const auto& kv : cases) known += (known.empty() ? "" : ", ") + key_text(kv.first, name, "cases");
       }
       throw ConfigError(name + ": cases: no case '" + case_name + "'" +
                         (known.empty() ? " (the file defines none)" : " (cases: " + known + ")"));
@@ -78,7 +89,7 @@ ConfigReader ConfigReader::from_root(YAML::Node root, const std::string& name, c
                         ": expected a mapping of keys to override");
     }
     root.remove("cases");
-    merge_into(root, chosen);
+    merge_into(root, chosen, name);
   } else {
     root.remove("cases");
   }
@@ -102,8 +113,10 @@ ConfigReader ConfigReader::from_string(const std::string& text, const std::strin
 std::vector<std::string> ConfigReader::case_names(const std::string& path) {
   const YAML::Node root = load_file(path);
   std::vector<std::string> names;
-  if (root.IsMap() && root["cases"].IsMap()) {
-    for (const auto& kv : root["cases"]) names.push_back(kv.first.as<std::string>());
+  // IsDefined() first: on a const node, a missing key is an invalid node whose
+  // IsMap() throws YAML::InvalidNode (found by tests/fuzz/fuzz_config).
+  if (root.IsMap() && root["cases"].IsDefined() && root["cases"].IsMap()) {
+    for (const auto& kv : root["cases"]) names.push_back(key_text(kv.first, path, "cases"));
   }
   return names;
 }
@@ -209,13 +222,13 @@ ConfigReader ConfigReader::child(const std::string& key) {
 
 std::vector<std::string> ConfigReader::keys() const {
   std::vector<std::string> out;
-  for (const auto& kv : node_) out.push_back(kv.first.as<std::string>());
+  for (const auto& kv : node_) out.push_back(key_text(kv.first, *file_, path_));
   return out;
 }
 
 void ConfigReader::reject_unknown_keys() const {
   for (const auto& kv : node_) {
-    const auto key = kv.first.as<std::string>();
+    const auto key = key_text(kv.first, *file_, path_);
     if (used_->count(key) == 0) {
       std::string known;
       for (const auto& k : *used_) known += (known.empty() ? "" : ", ") + k;

@@ -185,6 +185,13 @@ RunFile parse_run_file(std::istream& in, const std::string& name, const RunFileO
   if (n < std::max<std::size_t>(options.min_rows, 2))
     throw fail("only " + std::to_string(n) + " data rows (at least " +
                std::to_string(std::max<std::size_t>(options.min_rows, 2)) + " needed)");
+  // Finite cells can still span more than a double holds (-1e308 .. 1e308):
+  // the steps or the resampling grid would then be infinite.
+  if (!std::isfinite(t.back() - t.front())) {
+    std::ostringstream os;
+    os << "time span from " << t.front() << " to " << t.back() << " s is too large for a double";
+    throw fail(os.str());
+  }
 
   std::vector<double> steps(n - 1);
   for (std::size_t i = 1; i < n; ++i) {

@@ -5,3 +5,4 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 "$root/tools/setup.sh"
 cd "$root/build"
 ctest --output-on-failure -j"$(nproc)" --timeout 900
+"$root/tools/fuzz.sh" 10  # libFuzzer harnesses (tests/fuzz/README.md): corpus replay plus 10 s of fuzzing per target
