@@ -10,7 +10,8 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 
 packages=(cmake g++ make pkg-config liblcm-dev liblcm-bin libglib2.0-dev libmodbus-dev libspdlog-dev
           libfmt-dev libeigen3-dev libgtest-dev libgmock-dev libsocketcan-dev libyaml-cpp-dev libcli11-dev libnlopt-cxx-dev libceres-dev
-          libboost-dev libbenchmark-dev rt-tests iproute2 socat)
+          libboost-dev libbenchmark-dev rt-tests iproute2 socat
+          libssl-dev)  # libssl-dev: libcrypto HMAC-SHA256 for operator commands
 for arg in "$@"; do
   case "$arg" in
     --plots) packages+=(python3 python3-numpy python3-matplotlib) ;;
