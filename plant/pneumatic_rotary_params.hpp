@@ -27,6 +27,11 @@ struct PneumaticRotaryParams {
   double solenoid_gain = 0.161e-3;    // [m/V]: +-5 V gives +-0.81 mm
   double spool_limit = 0.81e-3;       // [m]
   double valve_null_offset = 0.0;     // [V] added to the command before the gain
+  // Spool overlap [m]: the lands still cover the ports for |x| below it, so
+  // the flow follows the opening sign(x) max(|x| - overlap, 0), a sharp dead
+  // band (Merritt; overlap > 0 is the "dead zone about null" of the cause id
+  // valve_deadband). 0: a critically lapped spool, as the paper assumes.
+  double valve_overlap = 0.0;
   double flow_gain = 1.5;             // C1 [kg/(s m)] per metre of spool travel (paper's "1.5/kg m" slip)
   double flow_pressure_coefficient = 4e-9;  // C2 [kg/(s Pa)] (paper's "0.4e-8 ms")
   bool dither = true;

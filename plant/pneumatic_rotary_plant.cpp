@@ -78,6 +78,14 @@ double PneumaticRotaryPlant::spool_position(double u, double t) const {
   return std::clamp(p.solenoid_gain * volts, -p.spool_limit, p.spool_limit);
 }
 
+double PneumaticRotaryPlant::port_opening(double x) const {
+  const double o = params_.valve_overlap;
+  if (!(o > 0.0)) return x;
+  if (x > o) return x - o;
+  if (x < -o) return x + o;
+  return 0.0;
+}
+
 double PneumaticRotaryPlant::end_stop_torque(double theta, double omega) const {
   const auto& p = params_;
   // A stop can push but not pull: without the clamp the damper term would
@@ -106,7 +114,7 @@ void PneumaticRotaryPlant::derivatives(const Vec& y, double t, RotaryLoadMode mo
   const bool stuck = stick_slip_ && mode == RotaryLoadMode::kStuck;
   const double omega = stuck ? 0.0 : y[kOmega];
 
-  const double x = spool_position(u, t);
+  const double x = port_opening(spool_position(u, t));
   const double m_a = p.flow_gain * x - p.flow_pressure_coefficient * y[kPa];
   const double m_b = -p.flow_gain * x - p.flow_pressure_coefficient * y[kPb];
   dy[kPa] = gas_gain_ * m_a - motion_gain_ * omega;

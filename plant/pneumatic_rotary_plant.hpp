@@ -6,7 +6,8 @@
 //
 //   U_v = u + valve_null_offset + A_d sin(2 pi f_d t)       (dither if enabled)
 //   x   = sat(k_sol U_v, +-spool_limit)
-//   m_a =  C1 x - C2 p_a,    m_b = -C1 x - C2 p_b            (p: change from Pq)
+//   x_o = sign(x) max(|x| - overlap, 0)                      (spool overlap, 0 nominal)
+//   m_a =  C1 x_o - C2 p_a,  m_b = -C1 x_o - C2 p_b          (p: change from Pq)
 //   dp_a/dt = (gamma R T / V) m_a - gamma Pq alpha omega / V
 //   dp_b/dt = (gamma R T / V) m_b + gamma Pq alpha omega / V
 //   I domega/dt = alpha (p_a - p_b) + T_stop - T_hysteresis - T_friction
@@ -103,6 +104,8 @@ class PneumaticRotaryPlant : public SimulatedPlant {
 
   // Spool position [m] for command u [V] at plant time t [s].
   double spool_position(double u, double t) const;
+  // Port opening [m] at spool position x: x less the overlap, 0 inside it.
+  double port_opening(double x) const;
 
   double hysteresis_torque() const;  // as sim_t_hysteresis [N m]
   double friction_torque() const;    // as sim_t_friction [N m]
