@@ -54,6 +54,14 @@ void read_road(ConfigReader r, RoadProfileSpec& road) {
   road.iso.waves = static_cast<int>(iso.integer("waves", 1, 100000));
   road.iso.fade_in_distance = iso.number("fade_in_distance_m", 0.0, 1e5);
   iso.reject_unknown_keys();
+
+  auto tr = r.child("bump_train");  // humps on top of the kind above (diagnosis runs)
+  road.train.amplitude = tr.number("amplitude_m", -1.0, 1.0);
+  road.train.wavelength = tr.number("wavelength_m", 1e-3, 1e3);
+  road.train.start_time = tr.number("start_time_s", 0.0, 1e5);
+  road.train.interval = tr.number("interval_s", 1e-3, 1e5);
+  road.train.count = static_cast<int>(tr.integer("count", 0, 100000));
+  tr.reject_unknown_keys();
   r.reject_unknown_keys();
 }
 
@@ -87,11 +95,15 @@ void read_half_car_plant(ConfigReader r, HalfCarParams& p) {
   auto fx = r.child("effects");
   p.damper_rebound_factor = fx.number("damper_rebound_factor", 1e-3, 1e3);
   p.actuator_time_constant = fx.number("actuator_time_constant_s", 0.0, 10.0);
+  p.actuator_valve_time_constant = fx.number("actuator_valve_time_constant_s", 0.0, 10.0);
   p.actuator_force_limit = fx.number("actuator_force_limit_n", 0.0, kInf);
   fx.reject_unknown_keys();
 
   p.gravity = r.number("gravity_m_s2", 0.0, 100.0);
   read_road(r.child("road"), p.road);
+  if (const auto& tr = p.road.train; tr.count > 0 && tr.amplitude != 0.0 && tr.interval < tr.wavelength / p.speed) {
+    r.child("road").child("bump_train").fail("interval_s", "must be at least one hump's duration (wavelength / speed)");
+  }
   try {
     validate(p);
   } catch (const std::invalid_argument& e) {

@@ -70,6 +70,10 @@ void validate(const HalfCarParams& p) {
   non_negative(p.tyre_damping_2, "tyre_damping_2");
   positive(p.damper_rebound_factor, "damper_rebound_factor");
   non_negative(p.actuator_time_constant, "actuator_time_constant");
+  non_negative(p.actuator_valve_time_constant, "actuator_valve_time_constant");
+  if (p.actuator_valve_time_constant > 0.0 && !(p.actuator_time_constant > 0.0)) {
+    throw std::invalid_argument("half car: actuator_valve_time_constant needs actuator_time_constant > 0");
+  }
   non_negative(p.actuator_force_limit, "actuator_force_limit");
   positive(p.speed, "speed");
   if (!std::isfinite(p.curve_radius)) throw std::invalid_argument("half car: curve_radius must be finite");

@@ -49,6 +49,11 @@ struct HalfCarParams {
   // shared/spec/measured-data.md. The linear model of eq. 5 ignores them.
   double damper_rebound_factor = 1.0;  // rebound (extension) damping / compression damping; 1 = linear damper
   double actuator_time_constant = 0.0; // [s] first-order lag of the active force behind its command; 0 = ideal
+  // [s] a second, faster lag ahead of the first (the servo-valve spool
+  // feeding the force loop): with it the actuator is second order, force
+  // following command through 1/((tau1 s + 1)(tau2 s + 1)), whose mean delay
+  // is tau1 + tau2. Needs actuator_time_constant > 0; 0 = none.
+  double actuator_valve_time_constant = 0.0;
   double actuator_force_limit = 0.0;   // [N] actuator saturation in the plant; 0 = none (controllers clamp)
 
   // Vehicle speed: sets the bump's timing, the rear delay (a + b)/V of

@@ -9,7 +9,7 @@ namespace {
 
 // State vector layout.
 constexpr std::size_t kZs = 0, kPhi = 1, kZu1 = 2, kZu2 = 3, kVs = 4, kOmega = 5, kVu1 = 6, kVu2 = 7, kF1 = 8,
-                      kF2 = 9;
+                      kF2 = 9, kValve1 = 10, kValve2 = 11;
 
 WheelArrangement arrangement_of(const HalfCarParams& p) {
   return p.plane == HalfCarPlane::kPitch ? WheelArrangement::kInLine : WheelArrangement::kSideBySide;
@@ -61,11 +61,12 @@ void HalfCarPlant::reset() {
 }
 
 HalfCarState HalfCarPlant::state() const {
-  return {y_[kZs], y_[kPhi], y_[kZu1], y_[kZu2], y_[kVs], y_[kOmega], y_[kVu1], y_[kVu2], y_[kF1], y_[kF2], t_};
+  return {y_[kZs], y_[kPhi], y_[kZu1], y_[kZu2], y_[kVs], y_[kOmega], y_[kVu1], y_[kVu2], y_[kF1], y_[kF2], t_,
+          y_[kValve1], y_[kValve2]};
 }
 
 void HalfCarPlant::set_state(const HalfCarState& s) {
-  y_ = {s.z_s, s.phi, s.z_u1, s.z_u2, s.v_s, s.omega, s.v_u1, s.v_u2, s.f_act1, s.f_act2};
+  y_ = {s.z_s, s.phi, s.z_u1, s.z_u2, s.v_s, s.omega, s.v_u1, s.v_u2, s.f_act1, s.f_act2, s.f_valve1, s.f_valve2};
   t_ = s.time;
   u_ = {s.f_act1, s.f_act2};
 }
@@ -117,11 +118,16 @@ void HalfCarPlant::derivatives(const Vec& y, double t, Vec& dy) const {
   dy[kPhi] = y[kOmega];
   dy[kVs] = heave / p.mass_body;
   dy[kOmega] = moment / p.inertia_body;
+  dy[kF1] = dy[kF2] = dy[kValve1] = dy[kValve2] = 0.0;
   if (p.actuator_time_constant > 0.0) {
-    dy[kF1] = (u_[0] - y[kF1]) / p.actuator_time_constant;
-    dy[kF2] = (u_[1] - y[kF2]) / p.actuator_time_constant;
-  } else {
-    dy[kF1] = dy[kF2] = 0.0;
+    const bool valve = p.actuator_valve_time_constant > 0.0;
+    for (std::size_t i = 0; i < 2; ++i) {
+      // Command -> valve stage (tau2) -> force loop (tau1); without the valve
+      // stage the force loop follows the command directly.
+      const double drive = valve ? y[kValve1 + i] : u_[i];
+      dy[kF1 + i] = (drive - y[kF1 + i]) / p.actuator_time_constant;
+      if (valve) dy[kValve1 + i] = (u_[i] - y[kValve1 + i]) / p.actuator_valve_time_constant;
+    }
   }
 }
 
@@ -149,6 +155,7 @@ void HalfCarPlant::advance(std::span<const double> command, double dt) {
     }
     u_[i] = u;
     if (params_.actuator_time_constant <= 0.0) y_[kF1 + i] = u;  // ideal force source
+    if (params_.actuator_valve_time_constant <= 0.0) y_[kValve1 + i] = u;  // no valve stage: it passes the command
   }
   const int n = std::max(1, params_.substeps);
   const double h = dt / n;

@@ -15,8 +15,10 @@
 //    suspension force. The total force is also floored at 0 while in contact
 //    (tyre damping cannot pull either).
 //  * Optional effects (nominal off): rebound damping differing from
-//    compression, a first-order lag of the actuator force, actuator
-//    saturation.
+//    compression (piecewise linear: a sharp switch at zero rate), a first-
+//    or second-order lag of the actuator force (a valve stage ahead of the
+//    force loop), actuator saturation. The lags are states of the RK4, so
+//    they act within a control period, not per sample.
 // Fixed-step RK4 with `substeps` steps per advance(); road and roll moment are
 // evaluated at each stage's time. No allocation in advance() or measure().
 #pragma once
@@ -44,6 +46,8 @@ struct HalfCarState {
   double f_act1 = 0.0; // actuator forces acting now [N] (lag state)
   double f_act2 = 0.0;
   double time = 0.0;   // plant time since reset [s]: positions the road and the curve
+  double f_valve1 = 0.0;  // valve-stage forces [N] (second lag state; used with actuator_valve_time_constant)
+  double f_valve2 = 0.0;
 };
 
 // Indices into measure()'s output, in signals() order.
@@ -104,7 +108,7 @@ class HalfCarPlant : public SimulatedPlant {
   const HalfCarParams& params() const { return params_; }
 
  private:
-  static constexpr std::size_t kN = 10;
+  static constexpr std::size_t kN = 12;
   using Vec = std::array<double, kN>;
 
   void derivatives(const Vec& y, double t, Vec& dy) const;

@@ -40,6 +40,18 @@ RoadProfile::RoadProfile(const RoadProfileSpec& spec, double speed, WheelArrange
     if (!(spec.bump.cycles > 0.0)) throw std::invalid_argument("road: bump cycles must be positive");
     if (!std::isfinite(spec.bump.amplitude)) throw std::invalid_argument("road: bump amplitude must be finite");
   }
+  {
+    const auto& b = spec.train;
+    if (!std::isfinite(b.amplitude)) throw std::invalid_argument("road: bump train amplitude must be finite");
+    if (b.count < 0) throw std::invalid_argument("road: bump train count must not be negative");
+    if (b.count > 0 && b.amplitude != 0.0) {
+      if (!(b.wavelength > 0.0)) throw std::invalid_argument("road: bump train wavelength must be positive");
+      if (!(b.start_time >= 0.0)) throw std::invalid_argument("road: bump train start time must not be negative");
+      if (!(b.interval >= b.wavelength / speed)) {
+        throw std::invalid_argument("road: bump train interval must be at least one hump's duration (wavelength / speed)");
+      }
+    }
+  }
   if (spec.kind == RoadKind::kIso8608) {
     const auto& iso = spec.iso;
     if (!(iso.n_min > 0.0) || !(iso.n_max > iso.n_min)) {
@@ -87,6 +99,19 @@ RoadSample RoadProfile::bump(double tau) const noexcept {
   return {0.5 * b.amplitude * (1.0 - std::cos(w * tau)), 0.5 * b.amplitude * w * std::sin(w * tau)};
 }
 
+RoadSample RoadProfile::train(double t_wheel) const noexcept {
+  const auto& b = spec_.train;
+  if (b.count <= 0 || b.amplitude == 0.0) return {};
+  const double since = t_wheel - b.start_time;
+  if (since < 0.0) return {};
+  const double k = std::floor(since / b.interval);
+  if (k >= static_cast<double>(b.count)) return {};
+  const double tau = since - k * b.interval;
+  if (tau > b.wavelength / speed_) return {};
+  const double w = kTwoPi * speed_ / b.wavelength;
+  return {0.5 * b.amplitude * (1.0 - std::cos(w * tau)), 0.5 * b.amplitude * w * std::sin(w * tau)};
+}
+
 double RoadProfile::track_height(int track, double x) const noexcept {
   if (spec_.kind != RoadKind::kIso8608) return 0.0;
   const auto& phase = phase_[static_cast<std::size_t>(track)];
@@ -120,16 +145,19 @@ RoadSample RoadProfile::at(int wheel, double t) const noexcept {
   if (spec_.wheels == RoadWheels::kWheel1 && wheel != 0) return {};
   if (spec_.wheels == RoadWheels::kWheel2 && wheel != 1) return {};
   const double t_wheel = t - delay(wheel);
+  RoadSample base;
   switch (spec_.kind) {
-    case RoadKind::kFlat: return {};
-    case RoadKind::kBump: return bump(t_wheel - spec_.bump.start_time);
+    case RoadKind::kFlat: break;
+    case RoadKind::kBump: base = bump(t_wheel - spec_.bump.start_time); break;
     case RoadKind::kIso8608: {
       const int track = arrangement_ == WheelArrangement::kSideBySide ? wheel : 0;
       const RoadSample s = iso(track, speed_ * t_wheel);
-      return {s.z, s.dz * speed_};
+      base = {s.z, s.dz * speed_};
+      break;
     }
   }
-  return {};
+  const RoadSample extra = train(t_wheel);
+  return {base.z + extra.z, base.dz + extra.dz};
 }
 
 }  // namespace rigctl

@@ -26,6 +26,8 @@
 // 2048, 8192). The road fades in over `fade_in_distance` (half-cosine
 // window) so that a run starting at rest sees no step.
 //
+// Bump train: equal 1 - cos humps (BumpTrainSpec) added to any kind.
+//
 // Wheel arrangement: in line (pitch plane) both wheels run on one track and
 // wheel 2 (rear) sees it wheelbase/V later; side by side (roll plane) both
 // wheels reach a bump at the same time, and the ISO road has two
@@ -60,6 +62,19 @@ struct BumpSpec {
   double cycles = 2.0;       // humps: eq. 9's interval 0 <= t <= 2 lambda0 / V holds two
 };
 
+// A series of equal 1 - cos humps laid on top of any road kind (speed bumps,
+// or potholes with a negative amplitude): hump k starts at
+// start_time + k interval under wheel 1 (wheel 2 follows as for the other
+// kinds) and lasts wavelength / V. Used where a road must make the tyres
+// leave the ground at known, repeated instants (the diagnosis runs).
+struct BumpTrainSpec {
+  double amplitude = 0.0;   // [m] hump height (negative: a dip); 0 = no train
+  double wavelength = 1.0;  // [m] hump length
+  double start_time = 1.0;  // [s] wheel 1 reaches the first hump
+  double interval = 1.0;    // [s] from one hump to the next; at least one hump's duration
+  int count = 0;            // humps
+};
+
 struct IsoRoadSpec {
   IsoRoadClass road_class = IsoRoadClass::kC;
   double gd_n0 = 0.0;       // [m^3] Gd(n0); 0 = the class's geometric mean
@@ -75,6 +90,7 @@ struct RoadProfileSpec {
   RoadWheels wheels = RoadWheels::kBoth;
   BumpSpec bump;
   IsoRoadSpec iso;
+  BumpTrainSpec train;  // added to whichever kind
 };
 
 enum class WheelArrangement {
@@ -116,6 +132,7 @@ class RoadProfile {
 
  private:
   RoadSample bump(double tau) const noexcept;
+  RoadSample train(double t_wheel) const noexcept;
   RoadSample iso(int track, double x) const noexcept;
 
   RoadProfileSpec spec_;
