@@ -9,6 +9,9 @@
 
 namespace rigctl {
 
+// config/safety_config.cpp
+SafetyConfig read_safety(ConfigReader r);
+
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -160,6 +163,7 @@ RigConfig parse(ConfigReader root, const std::string& case_name) {
   c.controller = read_controller(root.child("controller"), c.rig, c.loop.period_s);
   c.profile = read_profile(root.child("profile"), c.file);
   if (root.has("limits")) c.limits = read_limits(root.child("limits"));
+  if (root.has("safety")) c.safety = read_safety(root.child("safety"));
   if (c.rig == "quarter_car") {
     read_quarter_car_plant(root.child("plant"), c.quarter_car);
   } else if (c.rig == "half_car") {

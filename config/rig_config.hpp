@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <optional>
 #include <string>
@@ -15,6 +16,7 @@
 #include "plant/half_car_params.hpp"
 #include "plant/pneumatic_rotary_params.hpp"
 #include "plant/quarter_car_params.hpp"
+#include "rt/limit_action.hpp"
 #include "rt/pi_controller.hpp"
 #include "rt/pvp_controller.hpp"
 #include "rt/realtime.hpp"
@@ -70,6 +72,42 @@ struct LimitConfig {
   double min = 0.0, max = 0.0;
 };
 
+// The `safety:` section (config/safety_config.cpp): the state machine's
+// ramps and staging, the action of the `limits:` ranges, and the limit
+// detectors. Channel names are resolved when the rig is assembled
+// (tools/rig_assembly.cpp), with errors naming safety.detectors.NAME.
+struct DetectorConfig {
+  std::string name;     // key under safety.detectors
+  std::string type;     // range | rate | tracking_error | valve_saturation | sample_age | overruns | open_circuit | stuck
+  std::string channel;  // input; valve_saturation and stuck: `output` goes to output; tracking_error: default controller.feedback
+  std::string output;   // valve_saturation, stuck: the valve output
+  double min = -std::numeric_limits<double>::infinity();
+  double max = std::numeric_limits<double>::infinity();
+  double duration_s = 0.0;
+  double tolerance = 0.0;
+  double command_min = 0.0;
+  int64_t max_count = 0;
+  double window_s = 1.0;
+  LimitAction action = LimitAction::kInterlock;
+  bool latch = true;
+};
+
+struct SafetyConfig {
+  bool auto_sequence = true;       // `rigctl run` without an operator
+  double low_settle_s = 0.0;       // timed hydraulic staging
+  double high_settle_s = 0.0;
+  double hold_deceleration = 1.0;  // [unit/s^2] of the feedback channel
+  double setpoint_rate = 0.05;     // [unit/s]
+  double setpoint_min = -std::numeric_limits<double>::infinity();
+  double setpoint_max = std::numeric_limits<double>::infinity();
+  double stop_timeout_s = 5.0;
+  LimitAction limits_action = LimitAction::kInterlock;  // action of the `limits:` ranges
+  std::vector<DetectorConfig> detectors;
+};
+
+
+LimitAction limit_action_from_string(const std::string& s);
+
 struct RigConfig {
   std::string file;
   std::string case_name;  // the `cases:` entry applied, "" for none
@@ -84,6 +122,7 @@ struct RigConfig {
   ControllerConfig controller;
   ProfileConfig profile;
   std::vector<LimitConfig> limits;
+  SafetyConfig safety;  // `safety:`; optional, defaults as SafetyConfig{}
   QuarterCarParams quarter_car;          // rig quarter_car
   PneumaticRotaryParams pneumatic_rotary;  // rig pneumatic_rotary
   HalfCarParams half_car;                  // rig half_car

@@ -1,5 +1,7 @@
-// Per-tick plausibility and range checks on the inputs. The first violation
-// found is reported as an event; the loop then makes the rig safe.
+// Per-tick plausibility and range checks on the inputs (the config's
+// `limits:`). The first violation found is reported as an event. The loop
+// runs these as interlock detectors of rt/limit_detectors.hpp
+// (LimitDetectors::from_limit_check), next to the `safety:` detectors.
 #pragma once
 
 #include <cmath>
@@ -37,6 +39,7 @@ class LimitCheck {
   }
 
   const std::vector<InputLimit>& limits() const { return limits_; }
+  std::size_t input_count() const { return input_count_; }
 
  private:
   std::vector<InputLimit> limits_;

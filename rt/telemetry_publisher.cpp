@@ -14,6 +14,7 @@
 #include <lcm/lcm-cpp.hpp>
 #include <spdlog/spdlog.h>
 
+#include "rt/event_text.hpp"
 #include "rigctl/command_t.hpp"
 #include "rigctl/controller_t.hpp"
 #include "rigctl/driver_status_t.hpp"
@@ -27,44 +28,15 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// A crash (or SIGKILL) of the process loses what is still in stdio's buffer;
-// flushing it to the kernel at least this often bounds that loss to ~1 s of
-// telemetry. (It is not an fsync: a power cut may lose more.)
-constexpr auto kLogFlushInterval = std::chrono::seconds(1);
+// A crash (or SIGKILL) of the process loses what is still in stdio's buffer
+// (and in the queue the thread has not drained yet). Flushing the buffer to
+// the kernel this often bounds the first part to 250 ms of telemetry; a
+// flush is one write(2) of at most a few kB, four a second cost nothing.
+// (It is not an fsync: a power cut may lose more. SAFETY.md has the
+// measured loss.)
+constexpr auto kLogFlushInterval = std::chrono::milliseconds(250);
 constexpr auto kIdleSleep = std::chrono::milliseconds(1);
-
-std::string format_g(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
-
-// Human-readable text of an event; the record carries only codes so that the
-// real-time side never formats strings.
-std::string event_message(const Event& ev, const ChannelLayout& layout) {
-  std::string channel;
-  std::string unit;
-  if (ev.channel >= 0 && static_cast<std::size_t>(ev.channel) < layout.inputs.size()) {
-    channel = layout.inputs[ev.channel].name;
-    unit = layout.inputs[ev.channel].unit;
-  } else if (ev.channel >= 0) {
-    channel = "input " + std::to_string(ev.channel);
-  }
-  const std::string value = format_g(ev.value) + (unit.empty() ? "" : " " + unit);
-  switch (ev.code) {
-    case EventCode::kNone: return "";
-    case EventCode::kRunStarted: return "run started";
-    case EventCode::kProfileFinished: return "profile finished";
-    case EventCode::kStopRequested: return "stop requested";
-    // The limits themselves are not in the record: name channel and value.
-    case EventCode::kLimitTripped: return channel + " = " + value + " outside its limits";
-    case EventCode::kInputInvalid: return channel + " invalid (value " + value + ")";
-    case EventCode::kDriverReadFailed:
-      return channel.empty() ? "driver read failed" : "driver read failed on " + channel;
-    case EventCode::kQueueOverflow: return "telemetry queue dropped " + format_g(ev.value) + " records";
-  }
-  return "unknown event";
-}
+constexpr auto kDriverStatusInterval = std::chrono::seconds(1);  // driver counters: once a second, as documented
 
 // Names, units and values of a layout's channels into a message's arrays;
 // returns the count. The constructor made sure the layout fits the record.
@@ -80,14 +52,15 @@ int16_t fill_channels(const std::vector<ChannelInfo>& channels, const std::array
 }
 
 // The one place a message is encoded, published and logged, so that the log
-// holds exactly the bytes that went onto the bus.
+// holds exactly the bytes that went onto the bus. Returns 0, or the errno of
+// a failed log write (the caller reports it; the loop is never affected).
 template <typename Msg>
-void emit(lcm::LCM& lcm, lcm::LogFile* log, const std::string& channel, int64_t utime, const Msg& msg) {
+int emit(lcm::LCM& lcm, lcm::LogFile* log, const std::string& channel, int64_t utime, const Msg& msg) {
   const int size = msg.getEncodedSize();
   std::vector<uint8_t> buf(static_cast<std::size_t>(size));
   if (msg.encode(buf.data(), 0, size) != size) {
     spdlog::error("telemetry: encoding a message for {} failed", channel);
-    return;
+    return 0;
   }
   if (lcm.publish(channel, buf.data(), static_cast<unsigned int>(size)) != 0) {
     // A broken bus fails on every tick: warn on the first and every 10000th.
@@ -100,11 +73,10 @@ void emit(lcm::LCM& lcm, lcm::LogFile* log, const std::string& channel, int64_t 
     ev.channel = channel;
     ev.datalen = size;
     ev.data = buf.data();
-    if (log->writeEvent(&ev) != 0) {
-      static std::atomic<int64_t> failures{0};
-      if (failures.fetch_add(1) % 10000 == 0) spdlog::warn("telemetry: writing the log failed: {}", std::strerror(errno));
-    }
+    errno = 0;
+    if (log->writeEvent(&ev) != 0) return errno != 0 ? errno : EIO;
   }
+  return 0;
 }
 
 }  // namespace
@@ -170,7 +142,7 @@ void TelemetryPublisher::publish_driver_status() {
   m.num_counters = static_cast<int16_t>(m.counters.size());
   m.events = std::move(d.events);
   m.num_events = static_cast<int16_t>(m.events.size());
-  emit(*lcm_, log_.get(), channels_.driver, m.utime, m);
+  note_log_result(emit(*lcm_, log_.get(), channels_.driver, m.utime, m));
 }
 
 void TelemetryPublisher::start() {
@@ -189,10 +161,58 @@ void TelemetryPublisher::stop() {
   TelemetryRecord record;
   while (queue_.try_pop(record)) publish_record(record);
   publish_driver_status();
+  publish_reports();
+  flush_log();
   log_.reset();  // lcm_eventlog_destroy flushes and closes the file
 }
 
 lcm::LCM& TelemetryPublisher::lcm() { return *lcm_; }
+
+void TelemetryPublisher::flush_log() {
+  if (!log_) return;
+  errno = 0;
+  if (std::fflush(log_->getFilePtr()) != 0) note_log_result(errno != 0 ? errno : EIO);
+}
+
+// A full disk shows here (usually at the flush: writes go into stdio's
+// buffer). Reported once on the console and on LCM, then every 10000th; the
+// loop never sees it and keeps the rig under control.
+void TelemetryPublisher::note_log_result(int err) {
+  if (err == 0) return;
+  const int64_t n = log_failures_.fetch_add(1);
+  if (n % 10000 != 0) return;
+  const std::string text = "run log write failed: " + std::string(std::strerror(err)) + " (" +
+                           std::to_string(n + 1) + " failures so far); the rig keeps running";
+  spdlog::error("telemetry: {}", text);
+  publish_state_event("log_write_failed", text, /*to_log=*/false);
+}
+
+void TelemetryPublisher::publish_state_event(const std::string& event, const std::string& message, bool to_log) {
+  rigctl::state_t st;
+  st.utime = meta_.start_utime + last_t_ns_ / 1000;
+  st.tick = -1;
+  st.t = static_cast<double>(last_t_ns_) * 1e-9;
+  st.state = std::string(to_string(last_state_));
+  st.event = event;
+  st.message = message;
+  st.safety_state = std::string(to_string(last_safety_state_));
+  // Not into a log that is failing: that would recurse.
+  emit(*lcm_, to_log ? log_.get() : nullptr, channels_.state, st.utime, st);
+}
+
+void TelemetryPublisher::report_event(const std::string& event, const std::string& message) {
+  std::lock_guard<std::mutex> lock(reports_mutex_);
+  reports_.emplace_back(event, message);
+}
+
+void TelemetryPublisher::publish_reports() {
+  std::vector<std::pair<std::string, std::string>> reports;
+  {
+    std::lock_guard<std::mutex> lock(reports_mutex_);
+    reports.swap(reports_);
+  }
+  for (const auto& [event, message] : reports) publish_state_event(event, message, log_failures_.load() == 0);
+}
 
 std::optional<TelemetryRecord> TelemetryPublisher::latest() const {
   std::lock_guard<std::mutex> lock(latest_mutex_);
@@ -201,16 +221,21 @@ std::optional<TelemetryRecord> TelemetryPublisher::latest() const {
 
 void TelemetryPublisher::thread_main() {
   auto last_flush = Clock::now();
+  auto last_status = last_flush;
   TelemetryRecord record;
   while (running_.load()) {
     const bool got = queue_.try_pop(record);
     if (got) publish_record(record);
     const auto now = Clock::now();
     if (now - last_flush >= kLogFlushInterval) {
-      publish_driver_status();
-      if (log_) std::fflush(log_->getFilePtr());
+      flush_log();
       last_flush = now;
     }
+    if (now - last_status >= kDriverStatusInterval) {
+      publish_driver_status();
+      last_status = now;
+    }
+    publish_reports();
     // Polling, not a condition variable: the real-time side must never make
     // a system call to wake us.
     if (!got) std::this_thread::sleep_for(kIdleSleep);
@@ -237,7 +262,7 @@ void TelemetryPublisher::publish_record(const TelemetryRecord& r) {
     s.rig = meta_.rig;
     s.status = static_cast<int32_t>(r.sample.status);
     s.num_channels = fill_channels(layout.inputs, r.sample.value, s.names, s.units, s.values);
-    emit(*lcm_, log, channels_.sample, utime, s);
+    note_log_result(emit(*lcm_, log, channels_.sample, utime, s));
 
     rigctl::command_t c;
     c.utime = utime;
@@ -246,7 +271,7 @@ void TelemetryPublisher::publish_record(const TelemetryRecord& r) {
     c.setpoint_name = meta_.setpoint_name;
     c.setpoint = r.controller.setpoint;
     c.num_outputs = fill_channels(layout.outputs, r.command.value, c.names, c.units, c.values);
-    emit(*lcm_, log, channels_.command, utime, c);
+    note_log_result(emit(*lcm_, log, channels_.command, utime, c));
 
     rigctl::controller_t k;
     k.utime = utime;
@@ -264,10 +289,11 @@ void TelemetryPublisher::publish_record(const TelemetryRecord& r) {
     k.output = r.controller.output;
     k.saturated = r.controller.saturated;
     k.integrator_held = r.controller.integrator_held;
-    emit(*lcm_, log, channels_.controller, utime, k);
+    note_log_result(emit(*lcm_, log, channels_.controller, utime, k));
   }
 
-  if (first_record_ || r.state != last_state_ || r.event.code != EventCode::kNone) {
+  if (first_record_ || r.state != last_state_ || r.safety_state != last_safety_state_ ||
+      r.event.code != EventCode::kNone) {
     rigctl::state_t st;
     st.utime = utime;
     st.tick = r.tick;
@@ -275,9 +301,11 @@ void TelemetryPublisher::publish_record(const TelemetryRecord& r) {
     st.state = std::string(to_string(r.state));
     st.event = std::string(to_string(r.event.code));
     st.message = event_message(r.event, layout);
-    emit(*lcm_, log, channels_.state, utime, st);
+    st.safety_state = std::string(to_string(r.safety_state));
+    note_log_result(emit(*lcm_, log, channels_.state, utime, st));
     first_record_ = false;
     last_state_ = r.state;
+    last_safety_state_ = r.safety_state;
   }
 
   if (r.has_timing) {
@@ -305,7 +333,7 @@ void TelemetryPublisher::publish_record(const TelemetryRecord& r) {
     m.compute_p50_ns = tm.compute.p50_ns;
     m.compute_p99_ns = tm.compute.p99_ns;
     m.compute_p999_ns = tm.compute.p999_ns;
-    emit(*lcm_, log, channels_.timing, utime, m);
+    note_log_result(emit(*lcm_, log, channels_.timing, utime, m));
   }
 
   // Counts records (the unit dropped() counts), not LCM messages.

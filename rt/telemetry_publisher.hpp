@@ -11,6 +11,7 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "drivers/driver.hpp"
@@ -69,6 +70,11 @@ class TelemetryPublisher final : public TelemetrySink {
   // events, published on channels().driver and logged. Set before start().
   void set_diagnostics_source(std::function<DriverDiagnostics()> source, std::string driver_name);
 
+  // From any non-real-time thread (the event log's writer): an event to
+  // publish on the STATE channel (and log), e.g. a failing event log.
+  void report_event(const std::string& event, const std::string& message);
+  int64_t log_failures() const { return log_failures_.load(); }
+
   void start();  // starts the publisher thread
   void stop();   // drains the queue, flushes and closes the log, joins the thread
 
@@ -85,6 +91,10 @@ class TelemetryPublisher final : public TelemetrySink {
   void thread_main();
   void publish_record(const TelemetryRecord& record);
   void publish_driver_status();
+  void publish_reports();
+  void publish_state_event(const std::string& event, const std::string& message, bool to_log);
+  void flush_log();
+  void note_log_result(int err);
 
   TelemetryMeta meta_;
   TelemetryChannels channels_;
@@ -101,6 +111,10 @@ class TelemetryPublisher final : public TelemetrySink {
   std::string driver_name_;
   int64_t last_t_ns_ = 0;  // rig time of the newest record, for driver status time stamps
   RigState last_state_ = RigState::kStarting;
+  SafetyState last_safety_state_ = SafetyState::kFaulted;
+  std::atomic<int64_t> log_failures_{0};
+  std::mutex reports_mutex_;
+  std::vector<std::pair<std::string, std::string>> reports_;
   bool first_record_ = true;
   bool stopped_ = false;
 };

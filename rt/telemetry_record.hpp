@@ -38,6 +38,21 @@ enum class EventCode : uint8_t {
   kInputInvalid,     // driver flagged input `channel` invalid (NaN, stale)
   kDriverReadFailed,  // no usable sample, or the driver could not deliver the commands
   kQueueOverflow,    // telemetry records were dropped (value = count)
+  // Safety core (rt/rig_state_machine.hpp, rt/limit_detectors.hpp). `detail`
+  // carries the command kind, rejection reason or limit action.
+  kStateChanged,      // value = the previous SafetyState, detail = the new one
+  kCommandAccepted,   // detail = OperatorCommandKind, value = its value
+  kCommandRejected,   // detail = Rejection (rt/rig_state_machine.hpp), channel = OperatorCommandKind
+  kRateLimit,         // input `channel` changed faster than its limit (value = rate)
+  kTrackingError,     // |demand - feedback| of input `channel` over its limit (value = error)
+  kValveSaturated,    // output `channel` at its saturation level too long (value = command)
+  kSampleStale,       // the sample time stamp stopped advancing (value = age [s])
+  kOverruns,          // too many loop overruns in the window (value = count)
+  kOpenCircuit,       // input `channel` at its rail: open-circuit transducer (value)
+  kSensorStuck,       // input `channel` did not change while the valve was commanded (value)
+  kStopTimeout,       // a controlled stop did not settle in time: valve made safe
+  kLogWriteFailed,    // a log write failed (disk full, I/O error); the rig keeps running
+  kFaultReset,        // every fault cleared and the latches were reset
 };
 
 constexpr std::string_view to_string(EventCode c) {
@@ -50,6 +65,19 @@ constexpr std::string_view to_string(EventCode c) {
     case EventCode::kInputInvalid: return "input_invalid";
     case EventCode::kDriverReadFailed: return "driver_read_failed";
     case EventCode::kQueueOverflow: return "queue_overflow";
+    case EventCode::kStateChanged: return "state_changed";
+    case EventCode::kCommandAccepted: return "command_accepted";
+    case EventCode::kCommandRejected: return "command_rejected";
+    case EventCode::kRateLimit: return "rate_limit";
+    case EventCode::kTrackingError: return "tracking_error";
+    case EventCode::kValveSaturated: return "valve_saturated";
+    case EventCode::kSampleStale: return "sample_stale";
+    case EventCode::kOverruns: return "overruns";
+    case EventCode::kOpenCircuit: return "open_circuit";
+    case EventCode::kSensorStuck: return "sensor_stuck";
+    case EventCode::kStopTimeout: return "stop_timeout";
+    case EventCode::kLogWriteFailed: return "log_write_failed";
+    case EventCode::kFaultReset: return "fault_reset";
   }
   return "unknown";
 }
@@ -58,6 +86,8 @@ struct Event {
   EventCode code = EventCode::kNone;
   int16_t channel = -1;  // input index the event is about, -1 when none
   double value = 0.0;
+  uint8_t detail = 0;    // code-specific (see EventCode)
+  uint8_t action = 0;    // LimitAction of a limit trip (rt/limit_action.hpp), 0 otherwise
 };
 
 struct TelemetryRecord {
@@ -69,6 +99,8 @@ struct TelemetryRecord {
   Command command;
   ControllerTerms controller;
   RigState state = RigState::kRunning;
+  SafetyState safety_state = SafetyState::kRunning;
+  bool valve_enabled = true;  // false: the driver holds its safe command, `command` was not written
   Event event;
   // Set on the ticks where the loop publishes its timing statistics.
   bool has_timing = false;

@@ -40,6 +40,7 @@ class TimingStats {
 
   TimingSummary summary() const noexcept;
   int64_t period_ns() const noexcept { return period_ns_; }
+  int64_t overruns() const noexcept { return overruns_; }  // running total, cheap (limit detectors read it every tick)
   OverrunPolicy policy() const noexcept { return policy_; }
 
  private:

@@ -18,8 +18,9 @@ ConsoleStatus::~ConsoleStatus() {
 std::string ConsoleStatus::line(const TelemetryRecord& r) const {
   const auto& in = meta_.layout.inputs[static_cast<std::size_t>(feedback_input_)];
   char buf[256];
-  std::snprintf(buf, sizeof buf, "  t %6.1f/%.1f s | %s %9.5f %s | %s %9.5f %s | error %9.5f | %s %+.4f",
-                static_cast<double>(r.sample.t_ns) * 1e-9, duration_s_, meta_.setpoint_name.c_str(),
+  std::snprintf(buf, sizeof buf, "  t %6.1f/%.1f s | %-15s | %s %9.5f %s | %s %9.5f %s | error %9.5f | %s %+.4f",
+                static_cast<double>(r.sample.t_ns) * 1e-9, duration_s_, std::string(to_string(r.safety_state)).c_str(),
+                meta_.setpoint_name.c_str(),
                 r.controller.setpoint, in.unit.c_str(), in.name.c_str(), r.controller.measurement, in.unit.c_str(),
                 r.controller.error, meta_.layout.outputs.empty() ? "out" : meta_.layout.outputs[0].name.c_str(),
                 r.controller.output);

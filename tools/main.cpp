@@ -8,6 +8,7 @@
 
 #include "config/config_reader.hpp"
 #include "tools/bench_command.hpp"
+#include "tools/cmd_command.hpp"
 #include "tools/diag_command.hpp"
 #include "tools/hidden_effects.hpp"
 #include "tools/log2csv.hpp"
@@ -46,6 +47,7 @@ int main(int argc, char** argv) {
   run_cmd->add_flag("--fast", run.fast, "Simulated plant only: run as fast as the CPU allows, same results as paced");
   run_cmd->add_option("--log", run.log_path, "LCM log file to write (default: a new file in the config's log_dir)");
   run_cmd->add_option("--csv", run.csv_path, "Also write the run as a CSV run file");
+  run_cmd->add_option("--events", run.events_path, "Event log to append to (default: <log>.events; SAFETY.md)");
   run_cmd->add_option("--lcm-url", run.lcm_url, "LCM URL, overrides telemetry.lcm_url (e.g. udpm://239.255.76.67:7667?ttl=1)");
   run_cmd->add_flag("--no-realtime{false}", run.realtime, "Do not try mlockall/SCHED_FIFO");
 
@@ -111,6 +113,20 @@ int main(int argc, char** argv) {
   make_cmd->add_option("--seed", make.seed, "Sensor-noise seed");
   make_cmd->add_option("--out", make.out_csv, "Run file to write (CSV)")->required();
   make_cmd->add_option("--truth", make.truth_json, "Write what was hidden (JSON)");
+
+  // Authenticated operator commands (issue 7; tools/cmd_command.hpp). The
+  // callback returns the exit code at once so no dispatch below is needed.
+  rigctl::CmdOptions opcmd;
+  auto* opcmd_cmd = app.add_subcommand("cmd", "Send an authenticated operator command to a rig and wait for its acknowledgement (docs/operator-commands.md)");
+  opcmd_cmd->add_option("command", opcmd.command, "arm|start|hold|resume|stop|reset|hydraulics-low|hydraulics-high|hydraulics-off|setpoint")->required();
+  opcmd_cmd->add_option("value", opcmd.value, "setpoint only: the new setpoint (SI units)");
+  opcmd_cmd->add_option("--key", opcmd.key_path, "Key file shared with the rig (mode 600, at least 32 bytes)")->required();
+  opcmd_cmd->add_option("--lcm-url", opcmd.lcm_url, "LCM URL of the rig network")->capture_default_str();
+  opcmd_cmd->add_option("--channel", opcmd.channel, "Command channel (replies on <channel>_ACK)")->capture_default_str();
+  opcmd_cmd->add_option("--sender", opcmd.sender, "Sender id (default USER@HOSTNAME)");
+  opcmd_cmd->add_option("--wait-ack", opcmd.wait_ack_s, "Seconds to wait for the rig's reply; 0: do not wait")->capture_default_str();
+  opcmd_cmd->add_option("--state-file", opcmd.state_path, "Sequence state file (default $XDG_STATE_HOME/rigctl/<sender>.seq)");
+  opcmd_cmd->callback([&] { std::exit(rigctl::run_cmd_command(opcmd, std::cout, std::cerr)); });
 
   CLI11_PARSE(app, argc, argv);
 

@@ -211,6 +211,85 @@ std::unique_ptr<FilteredProfile> make_profile(const RigConfig& c, double& durati
   return std::make_unique<FilteredProfile>(std::move(raw), p.filter_tau_s, c.loop.period_s);
 }
 
+DetectorKind detector_kind(const std::string& type) {
+  if (type == "range") return DetectorKind::kRange;
+  if (type == "rate") return DetectorKind::kRate;
+  if (type == "tracking_error") return DetectorKind::kTrackingError;
+  if (type == "valve_saturation") return DetectorKind::kValveSaturation;
+  if (type == "sample_age") return DetectorKind::kSampleAge;
+  if (type == "overruns") return DetectorKind::kOverruns;
+  if (type == "open_circuit") return DetectorKind::kOpenCircuit;
+  return DetectorKind::kStuck;
+}
+
+// Order matters: the first of the most severe trips names why a run ended.
+// Plausibility of every input first, then `limits:`, then `safety.detectors`
+// in file order.
+LimitDetectors make_detectors(const RigConfig& c, const ChannelLayout& layout, int feedback) {
+  std::vector<DetectorSpec> specs;
+  for (std::size_t i = 0; i < layout.inputs.size(); ++i) {
+    DetectorSpec s;
+    s.name = "invalid." + layout.inputs[i].name;
+    s.kind = DetectorKind::kInvalid;
+    s.channel = static_cast<int>(i);
+    specs.push_back(s);
+  }
+  for (const auto& l : c.limits) {
+    DetectorSpec s;
+    s.name = "limits." + l.channel;
+    s.kind = DetectorKind::kRange;
+    s.channel = required_input(c, layout, "limits." + l.channel, l.channel);
+    s.min = l.min;
+    s.max = l.max;
+    s.action = c.safety.limits_action;
+    specs.push_back(s);
+  }
+  for (const auto& d : c.safety.detectors) {
+    const std::string key = "safety.detectors." + d.name;
+    DetectorSpec s;
+    s.name = key;
+    s.kind = detector_kind(d.type);
+    s.min = d.min;
+    s.max = d.max;
+    s.duration_s = d.duration_s;
+    s.tolerance = d.tolerance;
+    s.command_min = d.command_min;
+    s.max_count = d.max_count;
+    s.window_s = d.window_s;
+    s.action = d.action;
+    s.latch = d.latch;
+    if (s.kind == DetectorKind::kTrackingError) {
+      s.channel = d.channel.empty() ? feedback : required_input(c, layout, key + ".channel", d.channel);
+    } else if (s.kind == DetectorKind::kValveSaturation) {
+      s.channel = required_output(c, layout, key + ".output", d.output);
+    } else if (s.kind != DetectorKind::kSampleAge && s.kind != DetectorKind::kOverruns) {
+      s.channel = required_input(c, layout, key + ".channel", d.channel);
+    }
+    if (s.kind == DetectorKind::kStuck) s.command_output = required_output(c, layout, key + ".output", d.output);
+    specs.push_back(s);
+  }
+  try {
+    return LimitDetectors(std::move(specs), layout.inputs.size(), feedback, c.loop.period_s);
+  } catch (const std::invalid_argument& e) {
+    config_fail(c, "safety.detectors", e.what());
+  }
+}
+
+SafetyOptions make_safety(const RigConfig& c, int feedback) {
+  SafetyOptions s;
+  s.auto_sequence = c.safety.auto_sequence;
+  s.feedback_input = feedback;
+  s.machine.period_s = c.loop.period_s;
+  s.machine.low_settle_s = c.safety.low_settle_s;
+  s.machine.high_settle_s = c.safety.high_settle_s;
+  s.machine.hold_deceleration = c.safety.hold_deceleration;
+  s.machine.setpoint_rate = c.safety.setpoint_rate;
+  s.machine.setpoint_min = c.safety.setpoint_min;
+  s.machine.setpoint_max = c.safety.setpoint_max;
+  s.machine.stop_timeout_s = c.safety.stop_timeout_s;
+  return s;
+}
+
 }  // namespace
 
 std::string setpoint_name_for(const std::string& rig) {
@@ -236,6 +315,9 @@ AssembledRig assemble_rig(const RigConfig& c) {
     limits.push_back({index, l.min, l.max});
   }
   rig.limits = LimitCheck(std::move(limits), layout.inputs.size());
+  const int feedback = layout.input_index(c.controller.feedback);
+  rig.detectors = make_detectors(c, layout, feedback);
+  rig.safety = make_safety(c, feedback);
   rig.profile = make_profile(c, rig.profile_duration_s);
   rig.setpoint_name = setpoint_name_for(c.rig);
   if (c.profile.start_from_measurement) rig.profile_start_input = layout.input_index(c.controller.feedback);

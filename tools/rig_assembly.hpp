@@ -12,6 +12,8 @@
 #include "plant/simulated_plant.hpp"
 #include "rt/controller.hpp"
 #include "rt/limit_check.hpp"
+#include "rt/limit_detectors.hpp"
+#include "rt/rig_loop.hpp"
 #include "rt/setpoint_profile.hpp"
 
 namespace rigctl {
@@ -20,7 +22,9 @@ struct AssembledRig {
   std::unique_ptr<Driver> driver;
   std::unique_ptr<Controller> controller;
   std::unique_ptr<FilteredProfile> profile;
-  LimitCheck limits;
+  LimitCheck limits;          // the `limits:` ranges alone (benchmarks, the legacy loop constructor)
+  LimitDetectors detectors;   // every input's plausibility, `limits:` and `safety.detectors`
+  SafetyOptions safety;       // the state machine's settings from `safety:`
   std::string setpoint_name;  // run-file column of the demand, e.g. "x_ref"
   double profile_duration_s = 0.0;
   int profile_start_input = -1;  // the feedback input the profile starts from, -1: the configured start

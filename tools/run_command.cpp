@@ -10,7 +10,9 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "config/config_reader.hpp"
 #include "config/rig_config.hpp"
+#include "rt/event_log.hpp"
 #include "rt/realtime.hpp"
 #include "rt/telemetry_publisher.hpp"
 #include "tools/console_status.hpp"
@@ -90,8 +92,21 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
   Driver* driver = rig.driver.get();
   publisher.set_diagnostics_source([driver] { return driver->diagnostics(); }, config.driver);
 
+  // The event log: every state change, trip and command, fsync'd per line.
+  report.events_path = options.events_path.empty() ? report.log_path + ".events" : options.events_path;
+  EventLog events(report.events_path, EventLogMeta{config.rig, rig.driver->layout(), meta.start_utime});
+  events.set_failure_handler([&publisher](const std::string& text) {
+    spdlog::error("{}", text);
+    publisher.report_event("log_write_failed", text);
+  });
+  if (!config.safety.auto_sequence && options.operator_commands == nullptr) {
+    throw ConfigError(config.file + ": safety.auto_sequence: false needs operator commands, and this run has no "
+                      "command receiver");
+  }
+
   rig.driver->start();
   publisher.start();  // before the real-time set-up: the publisher keeps normal priority
+  events.start();
 
   out << "rigctl run: " << config.rig << " (" << config.driver << " driver) from " << options.config_path
       << (options.case_name.empty() ? "" : " case " + options.case_name) << ", "
@@ -119,16 +134,21 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
     if (!options.fast) {
       status.emplace(publisher, meta, rig.driver->layout().input_index(config.controller.feedback), duration, out);
     }
-    RigLoop loop(*rig.driver, *rig.controller, *rig.profile, rig.limits, publisher, clock, loop_options);
+    RigLoop loop(*rig.driver, *rig.controller, *rig.profile, rig.detectors, publisher, clock, loop_options,
+                 rig.safety);
+    loop.set_event_sink(&events);
+    loop.set_operator_commands(options.operator_commands);
     try {
       result = loop.run(stop);
     } catch (...) {
+      events.stop();
       publisher.stop();  // keep what was recorded
       rig.driver->stop();
       throw;
     }
   }
   report.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  events.stop();
   publisher.stop();
   rig.driver->stop();
   result.dropped_records = publisher.dropped();
@@ -137,12 +157,15 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
   const auto& t = result.timing;
   out << "  ended: " << to_string(result.final_state) << " (" << to_string(result.end_event.code);
   if (result.end_event.channel >= 0) {
-    out << ": " << meta.layout.inputs[static_cast<std::size_t>(result.end_event.channel)].name << " = "
-        << result.end_event.value;
+    // Valve saturation names an output; every other trip an input.
+    const auto& channels =
+        result.end_event.code == EventCode::kValveSaturated ? meta.layout.outputs : meta.layout.inputs;
+    const auto index = static_cast<std::size_t>(result.end_event.channel);
+    out << ": " << (index < channels.size() ? channels[index].name : "?") << " = " << result.end_event.value;
   }
   out << ") after " << result.ticks << " ticks ("
       << std::fixed << std::setprecision(3) << static_cast<double>(result.ticks) * config.loop.period_s
-      << " s rig time, " << report.wall_s << " s wall)\n";
+      << " s rig time, " << report.wall_s << " s wall), rig state " << to_string(result.final_safety_state) << "\n";
   if (!options.fast) {
     out << "  wake-up latency: " << describe(t.wakeup_latency) << "\n"
         << "  compute per tick: " << describe(t.compute) << "\n"
@@ -152,6 +175,11 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
   }
   if (report.loop.dropped_records > 0) out << "  telemetry records dropped: " << report.loop.dropped_records << "\n";
   out << "  log: " << report.log_path << "\n";
+  const EventLogStats es = events.stats();
+  out << "  events: " << report.events_path << " (" << es.written << " lines, " << std::setprecision(2)
+      << "longest write+fsync " << es.max_fsync_ms << " ms" << (es.pending > 0 ? ", " + std::to_string(es.pending) + " NOT WRITTEN" : "")
+      << ")\n";
+  if (publisher.log_failures() > 0) out << "  run log write failures: " << publisher.log_failures() << "\n";
   if (!report.csv_path.empty()) {
     const auto csv = log_to_csv(report.log_path, report.csv_path, config.telemetry.channel_prefix);
     out << "  csv: " << report.csv_path << " (" << csv.rows << " rows)\n";

@@ -18,15 +18,20 @@ struct RunOptions {
   std::optional<double> duration_s;  // default: the profile's length
   bool fast = false;                 // simulated plant only: no pacing
   std::string log_path;              // default: <log_dir>/<rig>-<time>.lcm
+  std::string events_path;           // event log; default: <log_path>.events
   std::string csv_path;              // optional run-file CSV
   std::string lcm_url;               // overrides telemetry.lcm_url
   bool realtime = true;              // false: skip mlockall/SCHED_FIFO (tests)
+  // Operator commands (the LCM command receiver pushes them); nullptr: none.
+  // With `safety.auto_sequence: false` the rig then moves only on these.
+  SpscQueue<OperatorCommand>* operator_commands = nullptr;
 };
 
 struct RunReport {
   LoopResult loop;
   std::string log_path;
   std::string csv_path;
+  std::string events_path;
   double wall_s = 0.0;
 };
 
