@@ -19,6 +19,36 @@ struct BearingFrictionParams {
   double damper_free_length = 0.342;   // L_d [m], paper
 };
 
+// Physics the nominal model (and the diagnosis baseline) leaves out, for the
+// hidden-effect generator (tools/gen_quarter_car.cpp). All off by default.
+// Each is written in a form the diagnosis does not fit (its candidates are
+// smoother or simpler), so that finding them tests the physics, not a formula.
+struct QuarterCarHiddenEffects {
+  // Actuator seal friction on the rod, Simscape "Cylinder Friction" style:
+  // Coulomb level F_pr + f_c (p1 + p2), a Stribeck peak and viscous term,
+  // F = sqrt(2e)(Fbrk - Fc) exp(-(v/v_st)^2) v/v_st + Fc tanh(v/v_coul) + f v.
+  double seal_preload = 0.0;              // F_pr [N]
+  double seal_pressure_coefficient = 0.0; // f_c [N/Pa]
+  double seal_breakaway_ratio = 1.3;      // F_brk / F_c [1]
+  double seal_breakaway_velocity = 0.02;  // v_brk [m/s]; v_st = v_brk sqrt(2), v_coul = v_brk / 2
+  double seal_viscous = 0.0;              // f [N s/m]
+  // A worn piston seal: turbulent cross-port flow K sign(dp) sqrt|dp|
+  // (laminar below the valve's laminar pressure), beside the nominal laminar leak.
+  double worn_seal_orifice = 0.0;         // K [m^3/s/sqrt(Pa)]
+  // Spool overlap: no metering until |x_s| exceeds it, a sharp dead band.
+  double valve_overlap = 0.0;             // [fraction of rated spool travel]
+  // Entrained air: effective bulk modulus of oil with free air, Simscape
+  // isothermal-liquid mixture law (shared/diagnosis-notes.md 2.4), n = 1.
+  double air_fraction = 0.0;              // alpha at atmospheric pressure [1]
+  // Damper with different rebound and compression coefficients (piecewise
+  // linear in the relative velocity). 1, 1: the nominal symmetric damper.
+  double damper_compression_factor = 1.0; // v_w - v_b > 0
+  double damper_rebound_factor = 1.0;     // v_w - v_b < 0
+  // The tyre cannot pull: contact force max(0, F). 0 keeps the nominal
+  // bilateral tyre; 1 is a real contact; between, that part of a pull is lost.
+  double tyre_pull_loss = 0.0;
+};
+
 struct QuarterCarParams {
   // Hydraulic actuator and servovalve.
   double area_cap = 1.96e-3;       // A1 [m^2]
@@ -52,6 +82,7 @@ struct QuarterCarParams {
   double gravity = 9.81;             // g [m/s^2]
 
   BearingFrictionParams bearing_friction;
+  QuarterCarHiddenEffects hidden;
 
   // Fixed integration sub-steps per control period (RK4). 20 at 2.5 ms gives
   // 0.125 ms, well inside the stability limit of the ~770 Hz hydraulic mode.

@@ -112,10 +112,44 @@ double QuarterCarPlant::end_stop_force(double x_r, double v_r) const {
   return 0.0;
 }
 
+double QuarterCarPlant::suspension_force(const Vec& y) const {
+  const auto& p = params_;
+  const double v_rel = y[kVw] - y[kVb];
+  const double c = p.damper_damping *
+                   (v_rel >= 0.0 ? p.hidden.damper_compression_factor : p.hidden.damper_rebound_factor);
+  return p.spring_stiffness * (y[kXw] - y[kXb]) + c * v_rel;
+}
+
+double QuarterCarPlant::tyre_force(const Vec& y) const {
+  const auto& p = params_;
+  const double f = (p.mass_body + p.mass_wheel) * p.gravity + p.tyre_stiffness * (y[kXr] - y[kXw]) +
+                   p.tyre_damping * (y[kVr] - y[kVw]);
+  return f < 0.0 ? (1.0 - p.hidden.tyre_pull_loss) * f : f;
+}
+
+double QuarterCarPlant::seal_friction(double v, double p1, double p2) const {
+  const auto& h = params_.hidden;
+  const double fc = h.seal_preload + h.seal_pressure_coefficient * std::max(0.0, p1 + p2);
+  if (fc == 0.0 && h.seal_viscous == 0.0) return 0.0;
+  const double v_st = h.seal_breakaway_velocity * std::sqrt(2.0), v_coul = h.seal_breakaway_velocity / 2.0;
+  const double fbrk = h.seal_breakaway_ratio * fc;
+  return std::sqrt(2.0 * M_E) * (fbrk - fc) * std::exp(-(v / v_st) * (v / v_st)) * v / v_st +
+         fc * std::tanh(v / v_coul) + h.seal_viscous * v;
+}
+
+double QuarterCarPlant::effective_bulk_modulus(double p) const {
+  const double alpha = params_.hidden.air_fraction;
+  if (alpha <= 0.0) return params_.bulk_modulus;
+  constexpr double pa = 101325.0;  // atmospheric [Pa abs]
+  const double pabs = std::max(pa + p, 1e3);
+  const double e = params_.bulk_modulus;
+  return e * (1.0 + alpha * pa / pabs) / (1.0 + alpha * pa * e / (pabs * pabs));
+}
+
 BearingFrictionLevels QuarterCarPlant::levels_at(const Vec& y) const {
   const auto& p = params_;
   const double deflection = y[kXw] - y[kXb];
-  const double f_susp = p.spring_stiffness * deflection + p.damper_damping * (y[kVw] - y[kVb]);
+  const double f_susp = suspension_force(y);
   return bearing_friction_levels(p.bearing_friction, p.mass_body * p.gravity, f_susp, deflection);
 }
 
@@ -125,27 +159,29 @@ void QuarterCarPlant::derivatives(const Vec& y, BearingMode mode, double u, Vec&
 
   dy[kXs] = (u - y[kXs]) / p.valve_time_constant;
 
-  const ValveFlows q = valve_flows(y[kXs], y[kP1], y[kP2], p.valve_flow_gain, p.supply_pressure,
-                                   p.laminar_pressure);
-  const double q_leak = p.leakage ? (y[kP1] - y[kP2]) / p.leakage_resistance : 0.0;
+  const double overlap = p.hidden.valve_overlap;
+  const double spool = std::abs(y[kXs]) <= overlap ? 0.0 : y[kXs] - std::copysign(overlap, y[kXs]);
+  const ValveFlows q = valve_flows(spool, y[kP1], y[kP2], p.valve_flow_gain, p.supply_pressure, p.laminar_pressure);
+  double q_leak = p.leakage ? (y[kP1] - y[kP2]) / p.leakage_resistance : 0.0;
+  if (p.hidden.worn_seal_orifice > 0.0) {
+    q_leak += p.hidden.worn_seal_orifice * orifice_root(y[kP1] - y[kP2], p.laminar_pressure);
+  }
   const double v1 = std::max(p.dead_volume_cap + p.area_cap * (y[kXr] - p.stroke_min), kMinVolume);
   const double v2 = std::max(p.dead_volume_rod + p.area_rod * (p.stroke_max - y[kXr]), kMinVolume);
-  double dp1 = p.bulk_modulus / v1 * (q.q1 - p.area_cap * y[kVr] - q_leak);
-  double dp2 = p.bulk_modulus / v2 * (p.area_rod * y[kVr] + q_leak - q.q2);
+  double dp1 = effective_bulk_modulus(y[kP1]) / v1 * (q.q1 - p.area_cap * y[kVr] - q_leak);
+  double dp2 = effective_bulk_modulus(y[kP2]) / v2 * (p.area_rod * y[kVr] + q_leak - q.q2);
   // At the cavitation floor the oil releases vapour instead of stretching.
   if (y[kP1] <= p.cavitation_pressure && dp1 < 0.0) dp1 = 0.0;
   if (y[kP2] <= p.cavitation_pressure && dp2 < 0.0) dp2 = 0.0;
   dy[kP1] = dp1;
   dy[kP2] = dp2;
 
-  const double f_tyre =
-      f0 + p.tyre_stiffness * (y[kXr] - y[kXw]) + p.tyre_damping * (y[kVr] - y[kVw]);
-  const double f_susp =
-      p.spring_stiffness * (y[kXw] - y[kXb]) + p.damper_damping * (y[kVw] - y[kVb]);
+  const double f_tyre = tyre_force(y);
+  const double f_susp = suspension_force(y);
 
   dy[kXr] = y[kVr];
   dy[kVr] = (y[kP1] * p.area_cap - y[kP2] * p.area_rod - p.rod_damping * y[kVr] - f_tyre -
-             p.mass_rod * p.gravity + end_stop_force(y[kXr], y[kVr])) /
+             p.mass_rod * p.gravity + end_stop_force(y[kXr], y[kVr]) - seal_friction(y[kVr], y[kP1], y[kP2])) /
             p.mass_rod;
   dy[kXw] = y[kVw];
   dy[kVw] = (f_tyre - f0 - f_susp) / p.mass_wheel;
@@ -184,8 +220,7 @@ void QuarterCarPlant::apply_floors(Vec& y) const {
 
 BearingMode QuarterCarPlant::mode_at_rest(const Vec& y) const {
   const auto& p = params_;
-  const double f_susp =
-      p.spring_stiffness * (y[kXw] - y[kXb]) + p.damper_damping * (y[kVw] - y[kVb]);
+  const double f_susp = suspension_force(y);
   if (std::abs(f_susp) > levels_at(y).breakaway) return sliding_mode(f_susp);
   return BearingMode::kStuck;
 }
@@ -246,16 +281,9 @@ void QuarterCarPlant::advance(std::span<const double> command, double dt) {
   for (int i = 0; i < n; ++i) substep(u, h);
 }
 
-double QuarterCarPlant::tyre_force() const {
-  const auto& p = params_;
-  return (p.mass_body + p.mass_wheel) * p.gravity + p.tyre_stiffness * (y_[kXr] - y_[kXw]) +
-         p.tyre_damping * (y_[kVr] - y_[kVw]);
-}
+double QuarterCarPlant::tyre_force() const { return tyre_force(y_); }
 
-double QuarterCarPlant::suspension_force() const {
-  const auto& p = params_;
-  return p.spring_stiffness * (y_[kXw] - y_[kXb]) + p.damper_damping * (y_[kVw] - y_[kVb]);
-}
+double QuarterCarPlant::suspension_force() const { return suspension_force(y_); }
 
 BearingFrictionLevels QuarterCarPlant::bearing_levels() const { return levels_at(y_); }
 

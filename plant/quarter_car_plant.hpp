@@ -139,6 +139,11 @@ class QuarterCarPlant : public SimulatedPlant {
   BearingMode mode_at_rest(const Vec& y) const;
   void settle_mode();
   BearingFrictionLevels levels_at(const Vec& y) const;
+  // With params_.hidden applied (nominal when it is default).
+  double suspension_force(const Vec& y) const;
+  double tyre_force(const Vec& y) const;
+  double seal_friction(double v_r, double p1, double p2) const;
+  double effective_bulk_modulus(double p) const;
   double end_stop_force(double x_r, double v_r) const;
 
   QuarterCarParams params_;

@@ -21,23 +21,11 @@ Json skipped(const std::string& reason) {
   return j;
 }
 
-Section diagnosis_section() {
-  return {"diagnosis", "diagnosis: time and peak memory of rigctl diagnose", [](Context& ctx) {
-            // The plan, once issue 6 lands: run `rigctl diagnose` on a 20 s
-            // quarter-car run file and on the EMPS record as child processes
-            // (bench::run_child gives wall time and peak RSS).
-            ctx.out << "  not yet: needs rigctl diagnose (issue 6)\n";
-            Json j = Json::object();
-            j["status"] = "not_available";
-            j["reason"] = "not yet: needs rigctl diagnose (issue 6)";
-            return j;
-          }};
-}
-
 namespace {
 
 std::vector<Section> all_sections() {
-  return {timing_section(), plant_section(), io_section(), diagnosis_section(), scaling_section()};
+  return {timing_section(), plant_section(), io_section(), diagnosis_section(), diagnosis_sweep_section(),
+          scaling_section()};
 }
 
 std::string utc_now() {

@@ -1,8 +1,7 @@
 // The sections of `rigctl bench`, one per file (tools/bench_<name>.cpp). A
 // section is a name, a title and a function from the shared context to its
-// JSON result; it prints its own tables to ctx.out. To add one (e.g. the
-// diagnosis timings once `rigctl diagnose` exists), write its function and
-// list it in all_sections() in bench_command.cpp.
+// JSON result; it prints its own tables to ctx.out. To add one, write its
+// function and list it in all_sections() in bench_command.cpp.
 //
 // JSON convention: every section object has "status": "ok", "skipped" (with
 // "reason": why it could not run on this machine), "not_available" (with
@@ -49,7 +48,8 @@ struct Section {
 Section timing_section();     // bench_timing.cpp
 Section plant_section();      // bench_plant.cpp
 Section io_section();         // bench_io.cpp
-Section diagnosis_section();  // bench_command.cpp (placeholder until rigctl diagnose exists)
+Section diagnosis_section();  // bench_diagnosis.cpp
+Section diagnosis_sweep_section();  // bench_diagnosis.cpp
 Section scaling_section();    // bench_scaling.cpp
 
 Json skipped(const std::string& reason);

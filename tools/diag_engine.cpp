@@ -167,12 +167,17 @@ Diagnosis diagnose(const RigModel& model, const DiagnoseOptions& opt) {
     for (std::size_t i = 0; i < n; ++i) r[i] = outs[o].measured[i] - s.y[o][i];
     return r;
   };
-  auto bic = [&](const Scored& s, std::size_t k) {
+  // N_eff of a model's residual (its colour); two models are compared with
+  // the same N_eff (the current model's), or a candidate whose residual is
+  // more coloured would be judged on fewer samples and lose for that alone.
+  auto n_eff = [&](const Scored& s) {
     std::vector<double> r;
     const auto e = residual_of(s, 0);
     for (std::size_t i = 0; i < n; ++i)
       if (est_mask[i]) r.push_back(e[i] * weight[0]);
-    const double neff = std::max(10.0, static_cast<double>(n_free_est) * effective_fraction(r));
+    return std::max(10.0, static_cast<double>(n_free_est) * effective_fraction(r));
+  };
+  auto bic = [&](const Scored& s, std::size_t k, double neff) {
     return neff * std::log(std::max(s.est_sse, 1e-300) / static_cast<double>(n_free_est)) +
            static_cast<double>(k) * std::log(neff);
   };
@@ -201,9 +206,12 @@ Diagnosis diagnose(const RigModel& model, const DiagnoseOptions& opt) {
     for (std::size_t e = 0; e < effects.size(); ++e) {
       if (tried[e] || std::find(active.begin(), active.end(), e) != active.end()) continue;
       say("round " + std::to_string(round) + ": screening " + effects[e].cause);
-      auto act = active;
-      act.push_back(e);
-      const auto free = free_for(act);
+      // Screening frees only the candidate's own parameters (baseline and
+      // effects already kept stay where the current fit put them): a cheap
+      // measure of how much the effect alone can explain; the best few are
+      // then refitted with everything free.
+      std::vector<bool> free(L.specs.size(), false);
+      for (std::size_t j = 0; j < effects[e].params.size(); ++j) free[L.offset[e] + j] = true;
       std::vector<std::vector<double>> starts;
       std::vector<double> st = current.theta;
       for (std::size_t j = 0; j < effects[e].params.size(); ++j) st[L.offset[e] + j] = effects[e].params[j].init;
@@ -309,7 +317,8 @@ Diagnosis diagnose(const RigModel& model, const DiagnoseOptions& opt) {
       if (reason.empty() && !significant) reason = "effect strength not significant (< 3 sigma)";
       std::size_t k_cur = L.n_base, k_new = L.n_base + effects[e].params.size();
       for (auto a : active) k_cur += effects[a].params.size(), k_new += effects[a].params.size();
-      if (reason.empty() && !(bic(s, k_new) < bic(current, k_cur))) reason = "BIC (with N_eff) not lower";
+      const double neff = n_eff(current);
+      if (reason.empty() && !(bic(s, k_new, neff) < bic(current, k_cur, neff))) reason = "BIC (with N_eff) not lower";
       sc.refitted = true;
       sc.gain_percent_points = gain;
       sc.signal = outs[sig].name;

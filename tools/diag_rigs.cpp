@@ -6,9 +6,6 @@
 #include <cmath>
 #include <filesystem>
 
-#include "config/rig_config.hpp"
-#include "plant/bearing_friction.hpp"
-#include "plant/quarter_car_params.hpp"
 #include "tools/diag_model.hpp"
 #include "tools/diag_rigs.hpp"
 #include "tools/diag_util.hpp"
@@ -265,137 +262,12 @@ class DamperModel : public RigModel {
   std::vector<Output> outputs_;
 };
 
-// ------------------------------------------------------------------ quarter_car
-
-// Suspension sub-model of seed 000: the measured road displacement x_r drives
-// the wheel (tyre spring-damper) and the body (suspension spring-damper);
-// x_w and x_b are the outputs. The actuator sub-model (u -> x_r, pressures)
-// is not replayed yet, so its causes are stubs.
-class QuarterCarModel : public RigModel {
- public:
-  QuarterCarModel(const RunFile& run, const RigModelOptions& o) : t_(run.t), dt_(run.dt) {
-    if (!o.config_path.empty()) {
-      const auto cfg = load_rig_config(o.config_path);
-      if (cfg.rig != "quarter_car") throw RunFileError("--config is a '" + cfg.rig + "' config, not quarter_car");
-      p_ = cfg.quarter_car;
-    }
-    xr_ = run.col("x_r");
-    vr_ = central_diff(xr_, dt_);
-    outputs_ = {{"x_b", run.col("x_b")}, {"x_w", run.col("x_w")}};
-    vb_ = run.has("v_b") ? run.col("v_b") : central_diff(run.col("x_b"), dt_);
-    vw_ = run.has("v_w") ? run.col("v_w") : central_diff(run.col("x_w"), dt_);
-  }
-  std::string rig() const override { return "quarter_car"; }
-  const std::vector<Output>& outputs() const override { return outputs_; }
-  const std::vector<double>& time() const override { return t_; }
-  std::vector<ParamSpec> baseline() const override {
-    return {P("ks", "N/m", p_.spring_stiffness, 1.0, 1e7, p_.spring_stiffness),
-            P("bd", "N s/m", p_.damper_damping, 0.0, 1e6, std::max(10.0, p_.damper_damping))};
-  }
-  std::vector<EffectSpec> effects() const override {
-    const std::string actuator = "needs the actuator sub-model replay (u -> x_r, p1, p2): not implemented yet";
-    return {
-        {"bearing_friction",
-         {P("Fc", "N", 20.0, 0.0, 1e4, 20.0, 0.0, true), P("dFs", "N", 0.0, 0.0, 1e4, 20.0),
-          P("D", "N s/m", 0.0, 0.0, 1e5, 100.0), P("mu", "1", 0.0, 0.0, 5.0, 0.05)},
-         "body linear-bearing friction: Coulomb Fc + mu F_n (normal force of the inclined spring-damper), "
-         "stiction excess dFs with a Stribeck decay (v_s 15 mm/s), viscous D, on the absolute body velocity"},
-        {"damper_asymmetry", {P("dc", "N s/m", 0.0, -1e5, 1e5, 100.0, 0.0, true)},
-         "rebound and compression damping differ: bd + dc tanh(v_rel / 0.01 m/s)"},
-        {"sensor_delay", {P("tau", "s", 0.002, 0.0, 0.1, 0.002, 0.0, true, {0.01})}, "x_w, x_b measured late by tau"},
-        {"sensor_offset",
-         {P("b_b", "m", 0.0, -0.1, 0.1, 1e-3, 0.0, true), P("b_w", "m", 0.0, -0.1, 0.1, 1e-3, 0.0, true)},
-         "constant offsets on the x_b and x_w transducers"},
-        {"tyre_liftoff", {P("unilateral", "1", 0.5, 0.0, 1.0, 1.0, 0.0, true)},
-         "the tyre cannot pull: contact force max(0, F) blended by `unilateral`"},
-        {"actuator_seal_friction", {}, actuator, true},
-        {"cross_port_leakage", {}, actuator, true},
-        {"valve_deadband", {}, actuator, true},
-        {"entrained_air", {}, actuator, true},
-    };
-  }
-  std::string replay() const override {
-    return "open-loop replay of the suspension sub-model: measured x_r (linear between samples) drives wheel and "
-           "body, 8 sub-steps per period, implicit (stick-capable) body-bearing friction update";
-  }
-  void simulate(const std::vector<double>& th, std::vector<std::vector<double>>& y) const override {
-    const double ks = th[0], bd = th[1], Fc = th[2], dFs = th[3], D = th[4], mu = th[5], dc = th[6], tau = th[7],
-                 b_b = th[8], b_w = th[9], uni = th[10];
-    const std::size_t n = t_.size();
-    y.assign(2, std::vector<double>(n));
-    const int sub = 8;
-    const double h = dt_ / sub;
-    const double mw = p_.mass_wheel, mb = p_.mass_body, kt = p_.tyre_stiffness, bt = p_.tyre_damping;
-    const double f0 = (mb + mw) * p_.gravity, weight = mb * p_.gravity;
-    const bool friction = Fc > 0.0 || dFs > 0.0 || D > 0.0 || mu > 0.0;
-    BearingFrictionParams bp = p_.bearing_friction;
-    double xw = outputs_[1].measured[0], xb = outputs_[0].measured[0], vw = vw_[0], vb = friction ? 0.0 : vb_[0];
-    for (std::size_t i = 0; i < n; ++i) {
-      y[0][i] = xb + b_b;
-      y[1][i] = xw + b_w;
-      const double xr0 = xr_[i], xr1 = i + 1 < n ? xr_[i + 1] : xr_[i];
-      const double vr = (xr1 - xr0) / dt_;
-      for (int s = 0; s < sub; ++s) {
-        const double xr = xr0 + (xr1 - xr0) * (s + 0.5) / sub;
-        const double vrel = vw - vb;
-        const double fs = ks * (xw - xb) + (bd + dc * std::tanh(vrel / 0.01)) * vrel;
-        double ft = kt * (xr - xw) + bt * (vr - vw);  // dynamic part, static f0 removed
-        if (uni > 0.0 && ft < -f0) ft = (1.0 - uni) * ft + uni * (-f0);
-        vw += h * (ft - fs) / mw;
-        xw += h * vw;
-        if (friction) {
-          double cn = Fc;
-          if (mu > 0.0) cn += mu * bearing_friction_levels(bp, weight, fs, xw - xb).normal;
-          const double c = cn + dFs * (vb == 0.0 ? 1.0 : std::exp(-(vb / 0.015) * (vb / 0.015)));
-          vb = implicit_velocity(mb, vb, fs, h, c, c, D, D);
-        } else {
-          vb += h * fs / mb;
-        }
-        xb += h * vb;
-      }
-      if (!std::isfinite(xb) || !std::isfinite(xw)) {
-        for (std::size_t j = i; j < n; ++j) y[0][j] = y[1][j] = 1e3;
-        return;
-      }
-    }
-    delay(y[0], tau, dt_);
-    delay(y[1], tau, dt_);
-  }
-  Indicator indicator(const std::string& cause) const override {
-    if (cause == "damper_asymmetry") {
-      std::vector<double> r(vw_.size());
-      for (std::size_t i = 0; i < r.size(); ++i) r[i] = vw_[i] - vb_[i];
-      return {"v_w - v_b [m/s]", r};
-    }
-    if (cause == "sensor_delay") return {"v_b [m/s]", vb_};
-    return {"body velocity v_b [m/s]", vb_};
-  }
-  std::vector<double> effect_term(const std::string& cause, const std::vector<double>& th) const override {
-    if (cause != "bearing_friction") return {};
-    // Sliding friction against measured body velocity, as a body-displacement-equivalent
-    // force is not comparable with the x_b residual: plotted in N / ks [m] so it shares the axis.
-    std::vector<double> f(vb_.size());
-    for (std::size_t i = 0; i < f.size(); ++i) {
-      const double v = vb_[i];
-      const double sgn = v > 0 ? 1.0 : (v < 0 ? -1.0 : 0.0);
-      f[i] = (sgn * (th[2] + th[3] * std::exp(-(v / 0.015) * (v / 0.015))) + th[4] * v) / th[0];
-    }
-    return f;
-  }
-
- private:
-  std::vector<double> t_, xr_, vr_, vb_, vw_;
-  double dt_;
-  QuarterCarParams p_;
-  std::vector<Output> outputs_;
-};
-
 }  // namespace
 
 std::unique_ptr<RigModel> make_rig_model(const std::string& rig, const RunFile& run, const RigModelOptions& o) {
   if (rig == "linear_axis") return std::make_unique<LinearAxisModel>(run, o);
   if (rig == "damper") return std::make_unique<DamperModel>(run, o);
-  if (rig == "quarter_car") return std::make_unique<QuarterCarModel>(run, o);
+  if (rig == "quarter_car") return make_quarter_car_model(run, o);
   if (rig == "pneumatic_rotary") return make_pneumatic_rotary_model(run, o);
   if (rig == "half_car") return make_half_car_model(run, o);
   throw RunFileError("unknown rig kind '" + rig + "'");

@@ -8,6 +8,9 @@
 
 namespace rigctl::diag {
 
+// tools/diag_quarter_car.cpp: seed 000's rig, two sub-models in one (the
+// actuator in the PI loop, the suspension driven by the measured road).
+std::unique_ptr<RigModel> make_quarter_car_model(const RunFile& run, const RigModelOptions& options);
 // tools/diag_pneumatic.cpp: closed-loop replay of theta_d through the P+V+dP
 // controller and the pneumatic rotary plant (seed 002).
 std::unique_ptr<RigModel> make_pneumatic_rotary_model(const RunFile& run, const RigModelOptions& options);

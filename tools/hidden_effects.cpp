@@ -122,6 +122,7 @@ std::vector<AppliedEffect> make_run(const MakeRunOptions& o, std::ostream& progr
   std::atomic<bool> stop{false};
   const RunReport report = run_rig(config, run, stop, progress);
   std::filesystem::remove(run.log_path);
+  std::filesystem::remove(run.log_path + ".events");  // the event log beside it (SAFETY.md)
   drop_truth_columns(o.out_csv);
   if (report.loop.final_state != RigState::kStopped) {
     throw std::runtime_error("the generated run ended " + std::string(to_string(report.loop.final_state)) +
