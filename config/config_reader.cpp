@@ -214,6 +214,27 @@ std::vector<double> ConfigReader::numbers(const std::string& key, std::size_t mi
   return out;
 }
 
+std::vector<std::string> ConfigReader::texts(const std::string& key,
+                                            const std::function<void(const std::string&)>& check) {
+  YAML::Node n = required(key);
+  if (!n.IsSequence()) fail_at(n, key, std::string("expected a list of strings, got ") + kind_name(n));
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    const std::string item = key + "[" + std::to_string(i) + "]";
+    if (!n[i].IsScalar()) fail_at(n[i], item, "expected a string");
+    const std::string v = n[i].as<std::string>();
+    if (check) {
+      try {
+        check(v);
+      } catch (const std::invalid_argument& e) {
+        fail_at(n[i], item, e.what());
+      }
+    }
+    out.push_back(v);
+  }
+  return out;
+}
+
 ConfigReader ConfigReader::child(const std::string& key) {
   YAML::Node n = required(key);
   if (!n.IsMap()) fail_at(n, key, std::string("expected a mapping of keys, got ") + kind_name(n));

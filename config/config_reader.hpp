@@ -5,6 +5,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <functional>
 #include <limits>
 #include <memory>
 #include <set>
@@ -41,6 +42,10 @@ class ConfigReader {
   std::vector<double> numbers(const std::string& key, std::size_t min_count, std::size_t max_count,
                               double min = -std::numeric_limits<double>::infinity(),
                               double max = std::numeric_limits<double>::infinity());
+  // A list of strings; `check` may throw std::invalid_argument for an item,
+  // which becomes an error naming KEY[i] and its line.
+  std::vector<std::string> texts(const std::string& key,
+                                 const std::function<void(const std::string&)>& check = {});
   ConfigReader child(const std::string& key);
   // Keys of a mapping child, in file order (for maps keyed by channel name).
   std::vector<std::string> keys() const;

@@ -164,6 +164,12 @@ RigConfig parse(ConfigReader root, const std::string& case_name) {
   c.profile = read_profile(root.child("profile"), c.file);
   if (root.has("limits")) c.limits = read_limits(root.child("limits"));
   if (root.has("safety")) c.safety = read_safety(root.child("safety"));
+  if (root.has("operator")) c.operator_commands = read_operator(root.child("operator"), c.file);
+  if (root.has("faults")) {
+    for (const auto& text : root.texts("faults", [](const std::string& t) { parse_fault_spec(t); })) {
+      c.faults.push_back(parse_fault_spec(text));
+    }
+  }
   if (c.rig == "quarter_car") {
     read_quarter_car_plant(root.child("plant"), c.quarter_car);
   } else if (c.rig == "half_car") {

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "config/operator_config.hpp"
 #include "config/suspension_controller_reader.hpp"
 #include "drivers/canopen_valve_config.hpp"
 #include "drivers/modbus_daq_config.hpp"
@@ -21,6 +22,7 @@
 #include "rt/pvp_controller.hpp"
 #include "rt/realtime.hpp"
 #include "rt/timing_stats.hpp"
+#include "tools/fault_spec.hpp"
 
 namespace rigctl {
 
@@ -123,6 +125,8 @@ struct RigConfig {
   ProfileConfig profile;
   std::vector<LimitConfig> limits;
   SafetyConfig safety;  // `safety:`; optional, defaults as SafetyConfig{}
+  OperatorConfig operator_commands;  // `operator:`; optional (config/operator_config.hpp)
+  std::vector<FaultSpec> faults;     // `faults:`; optional list of KIND@TIME[:ARG...] (drivers/sim_faults.hpp)
   QuarterCarParams quarter_car;          // rig quarter_car
   PneumaticRotaryParams pneumatic_rotary;  // rig pneumatic_rotary
   HalfCarParams half_car;                  // rig half_car

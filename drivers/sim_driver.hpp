@@ -1,9 +1,11 @@
 // The simulated rig behind the driver interface: a plant stepped one control
 // period per tick, seen through sensor models. Time is the tick count times
 // the period, never the wall clock, so a paced run and a --fast run of the
-// same config and seed are identical.
+// same config and seed are identical. Injected faults (drivers/sim_faults.hpp)
+// act on that same rig time.
 #pragma once
 
+#include <atomic>
 #include <memory>
 #include <random>
 #include <vector>
@@ -11,7 +13,9 @@
 #include "drivers/delay_line.hpp"
 #include "drivers/driver.hpp"
 #include "drivers/sensor_model.hpp"
+#include "drivers/sim_faults.hpp"
 #include "plant/simulated_plant.hpp"
+#include "rt/loop_clock.hpp"
 
 namespace rigctl {
 
@@ -31,11 +35,22 @@ class SimDriver final : public Driver {
   void make_safe() noexcept override;
   void stop() override {}
   bool simulated() const override { return true; }
+  // The injected faults as they happen, and sim_valve_safe_since_ns: the
+  // rig time since which the plant has had the safe command (-1: driven).
+  DriverDiagnostics diagnostics() override;
+
+  // Faults to inject, before start(). Throws std::invalid_argument naming a
+  // bad one (sim_faults.hpp).
+  void set_faults(const std::vector<FaultSpec>& faults);
+  // The loop's clock: an overrun fault's read stalls on it, wall time in a
+  // paced run, virtual time with --fast (the loop sees the same late tick).
+  void set_stall_clock(LoopClock* clock) { stall_clock_ = clock; }
 
   SimulatedPlant& plant() { return *plant_; }
 
  private:
   std::unique_ptr<SimulatedPlant> plant_;
+  std::vector<SensorSpec> sensor_specs_;
   std::vector<SensorModel> sensors_;
   std::vector<DelayLine> delays_;  // per signal; inactive where the spec has no delay
   std::vector<SensorModel> dacs_;
@@ -49,6 +64,9 @@ class SimDriver final : public Driver {
   std::vector<double> truth_;
   int64_t tick_ = 0;
   bool started_ = false;
+  SimFaults faults_;
+  LoopClock* stall_clock_ = nullptr;
+  std::atomic<int64_t> safe_since_ns_{0};
 };
 
 }  // namespace rigctl

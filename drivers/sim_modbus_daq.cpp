@@ -285,7 +285,10 @@ void SimModbusDaq::handle(const uint8_t* req, int length) noexcept {
     // What a gateway answers for a unit it cannot reach.
     modbus_reply_exception(ctx_, req, MODBUS_EXCEPTION_GATEWAY_TARGET);
   } else {
-    modbus_reply(ctx_, req, length, m->second);  // out-of-map addresses get "illegal data address"
+    const int replied = modbus_reply(ctx_, req, length, m->second);  // out-of-map addresses get "illegal data address"
+    if (replied > 0 && (function == MODBUS_FC_WRITE_SINGLE_REGISTER || function == MODBUS_FC_WRITE_MULTIPLE_REGISTERS)) {
+      ++writes_;
+    }
   }
   ++replies_;
 }

@@ -86,6 +86,8 @@ class SimModbusDaq {
   int64_t requests() const noexcept { return requests_.load(); }       // received
   int64_t replies() const noexcept { return replies_.load(); }         // answered (data or exception)
   int64_t connections() const noexcept { return connections_.load(); }  // TCP: accepted and kept
+  // Writes to holding registers answered: an output watchdog (rig-sim) counts time since the last.
+  int64_t writes() const noexcept { return writes_.load(); }
 
  private:
   struct InputState {
@@ -120,7 +122,7 @@ class SimModbusDaq {
   std::atomic<double> reply_delay_s_{0.0};
   std::atomic<bool> drop_requested_{false};
   std::atomic<int64_t> refuse_until_ns_{0};
-  std::atomic<int64_t> requests_{0}, replies_{0}, connections_{0};
+  std::atomic<int64_t> requests_{0}, replies_{0}, connections_{0}, writes_{0};
 };
 
 }  // namespace rigctl

@@ -76,7 +76,11 @@ QuarterCarState QuarterCarPlant::rest_state(const QuarterCarParams& p) {
   return s;
 }
 
-void QuarterCarPlant::reset() { set_state(rest_state(params_)); }
+void QuarterCarPlant::reset() {
+  supply_pressure_ = params_.supply_pressure;
+  chamber_leak_ = {};
+  set_state(rest_state(params_));
+}
 
 QuarterCarState QuarterCarPlant::state() const {
   QuarterCarState s;
@@ -161,15 +165,18 @@ void QuarterCarPlant::derivatives(const Vec& y, BearingMode mode, double u, Vec&
 
   const double overlap = p.hidden.valve_overlap;
   const double spool = std::abs(y[kXs]) <= overlap ? 0.0 : y[kXs] - std::copysign(overlap, y[kXs]);
-  const ValveFlows q = valve_flows(spool, y[kP1], y[kP2], p.valve_flow_gain, p.supply_pressure, p.laminar_pressure);
+  const ValveFlows q = valve_flows(spool, y[kP1], y[kP2], p.valve_flow_gain, supply_pressure_, p.laminar_pressure);
   double q_leak = p.leakage ? (y[kP1] - y[kP2]) / p.leakage_resistance : 0.0;
   if (p.hidden.worn_seal_orifice > 0.0) {
     q_leak += p.hidden.worn_seal_orifice * orifice_root(y[kP1] - y[kP2], p.laminar_pressure);
   }
   const double v1 = std::max(p.dead_volume_cap + p.area_cap * (y[kXr] - p.stroke_min), kMinVolume);
   const double v2 = std::max(p.dead_volume_rod + p.area_rod * (p.stroke_max - y[kXr]), kMinVolume);
-  double dp1 = effective_bulk_modulus(y[kP1]) / v1 * (q.q1 - p.area_cap * y[kVr] - q_leak);
-  double dp2 = effective_bulk_modulus(y[kP2]) / v2 * (p.area_rod * y[kVr] + q_leak - q.q2);
+  // Burst pipes (fault injection): each chamber spills to tank.
+  const double q_burst1 = chamber_leak_[0] > 0.0 ? chamber_leak_[0] * orifice_root(std::max(y[kP1], 0.0), p.laminar_pressure) : 0.0;
+  const double q_burst2 = chamber_leak_[1] > 0.0 ? chamber_leak_[1] * orifice_root(std::max(y[kP2], 0.0), p.laminar_pressure) : 0.0;
+  double dp1 = effective_bulk_modulus(y[kP1]) / v1 * (q.q1 - p.area_cap * y[kVr] - q_leak - q_burst1);
+  double dp2 = effective_bulk_modulus(y[kP2]) / v2 * (p.area_rod * y[kVr] + q_leak - q.q2 - q_burst2);
   // At the cavitation floor the oil releases vapour instead of stretching.
   if (y[kP1] <= p.cavitation_pressure && dp1 < 0.0) dp1 = 0.0;
   if (y[kP2] <= p.cavitation_pressure && dp2 < 0.0) dp2 = 0.0;

@@ -128,6 +128,16 @@ class QuarterCarPlant : public SimulatedPlant {
 
   const QuarterCarParams& params() const { return params_; }
 
+  // Fault-injection hooks (drivers/sim_faults.hpp): allocation-free, callable
+  // between advance() calls; reset() undoes both.
+  // The supply drops to p [Pa gauge]: a pump trip or a closed supply valve.
+  void set_supply_pressure(double p) noexcept { supply_pressure_ = p; }
+  // Chamber 1 (cap side) or 2 (rod side) opens to tank through an orifice
+  // K [m^3/s/sqrt(Pa)] (outflow only: a burst pipe spills, it does not suck).
+  void set_chamber_leak(int chamber, double k) noexcept {
+    if (chamber == 1 || chamber == 2) chamber_leak_[static_cast<std::size_t>(chamber - 1)] = k;
+  }
+
  private:
   static constexpr std::size_t kN = 9;
   using Vec = std::array<double, kN>;
@@ -151,6 +161,8 @@ class QuarterCarPlant : public SimulatedPlant {
   std::vector<ChannelInfo> commands_;
   Vec y_{};
   BearingMode mode_ = BearingMode::kStuck;
+  double supply_pressure_ = 0.0;            // params_.supply_pressure unless a fault lowered it
+  std::array<double, 2> chamber_leak_{};  // burst-pipe orifices to tank, 0 = intact
 };
 
 }  // namespace rigctl

@@ -56,6 +56,21 @@ bool EventLog::push(const EventRecord& record) noexcept {
   return false;
 }
 
+void EventLog::push_note(int64_t wall_utime, const std::string& code, const std::string& source, int64_t sequence,
+                         const std::string& message) {
+  char head[64];
+  std::snprintf(head, sizeof head, " t=%.6f tick=- state=-", static_cast<double>(wall_utime - meta_.start_utime) * 1e-6);
+  std::string line = iso_utc(wall_utime) + head + " code=" + code + " source=" + source;
+  if (sequence != 0) line += " seq=" + std::to_string(sequence);
+  // The text may carry bytes from the network (a rejected command's fields):
+  // no newline, quote or control character may forge or break a line.
+  line += " message=\"";
+  for (const char ch : message) line += (static_cast<unsigned char>(ch) < 0x20 || ch == '"' || ch == 0x7f) ? '?' : ch;
+  line += "\"";
+  const std::lock_guard<std::mutex> lock(notes_mutex_);
+  if (notes_.size() < kMaxPendingLines) notes_.push_back(std::move(line));
+}
+
 std::string EventLog::format(const EventRecord& r) const {
   char head[160];
   std::snprintf(head, sizeof head, " t=%.6f tick=%lld", static_cast<double>(r.t_ns) * 1e-9,
@@ -130,6 +145,13 @@ void EventLog::drain() {
   while (queue_.try_pop(r)) {
     if (pending_.size() < kMaxPendingLines) pending_.push_back(format(r));
     any = true;
+  }
+  {
+    const std::lock_guard<std::mutex> lock(notes_mutex_);
+    for (; !notes_.empty(); notes_.pop_front()) {
+      if (pending_.size() < kMaxPendingLines) pending_.push_back(std::move(notes_.front()));
+      any = true;
+    }
   }
   if (any) flush_pending();
 }

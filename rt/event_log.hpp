@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <mutex>
 #include <string>
 #include <thread>
 
@@ -52,6 +53,13 @@ class EventLog final : public EventSink {
   // Loop thread: never blocks.
   bool push(const EventRecord& record) noexcept override;
 
+  // Other (non-real-time) threads: an event the loop never saw, e.g. an
+  // operator command the receiver rejected (bad tag, stale, replayed). Takes
+  // a mutex; written by the writer thread in arrival order with the loop's
+  // events. The line has wall time and t but no tick or state (tick=- state=-).
+  void push_note(int64_t wall_utime, const std::string& code, const std::string& source, int64_t sequence,
+                 const std::string& message);
+
   // Called on the writer thread on the first failure and every 1000th after,
   // with a message naming the file and the error. Set before start().
   void set_failure_handler(std::function<void(const std::string&)> handler) { on_failure_ = std::move(handler); }
@@ -80,6 +88,8 @@ class EventLog final : public EventSink {
   std::atomic<bool> running_{false};
   bool stopped_ = false;
   std::deque<std::string> pending_;  // writer thread only
+  std::mutex notes_mutex_;
+  std::deque<std::string> notes_;    // push_note() lines, guarded by notes_mutex_
   std::function<void(const std::string&)> on_failure_;
   std::atomic<int64_t> written_{0}, failures_{0}, dropped_{0}, pending_count_{0};
   std::atomic<int64_t> max_fsync_ns_{0};

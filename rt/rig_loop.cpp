@@ -98,6 +98,9 @@ LoopResult RigLoop::run(const std::atomic<bool>& stop_requested) {
   Event worst_trip{};  // the most severe trip of the run (hold or worse makes the run count as faulted)
   bool ended_by_fault = false;
   bool stop_seen = false, stop_applied = false, end_stop_applied = false;
+  // Operator mode ends when the operator has stopped the rig and then turned
+  // the hydraulics off: the test is over and the rig is safe.
+  bool operator_stopped = false;
   bool valve_was_enabled = false;
   double last_demand = 0.0;
   Command last_command{};
@@ -113,6 +116,8 @@ LoopResult RigLoop::run(const std::atomic<bool>& stop_requested) {
         worst_trip = Event{};
       }
       if (c.kind == OperatorCommandKind::kArm) controller_.reset();  // take over the valve with a fresh integrator
+      if (source == EventSource::kOperator && c.kind == OperatorCommandKind::kStop) operator_stopped = true;
+      if (c.kind == OperatorCommandKind::kStart) operator_stopped = false;  // a new test after a re-arm
       if (c.kind == OperatorCommandKind::kStart) {
         // The profile from its beginning: its clock restarts at the run's first sample time.
         profile_.reset();
@@ -285,7 +290,9 @@ LoopResult RigLoop::run(const std::atomic<bool>& stop_requested) {
         end_stop_applied = true;
         if (machine_.valve_enabled()) command(OperatorCommand{OperatorCommandKind::kStop, 0.0, 0}, EventSource::kAutomatic, t_ns, true);
       }
-      const bool finishing = end_stop_applied || stop_seen || (safety_.auto_sequence && ever_ran_);
+      const bool operator_done = !safety_.auto_sequence && operator_stopped && machine_.state() == SafetyState::kOff;
+      if (operator_done && !stop_seen) end_event = Event{EventCode::kStopRequested, -1, 0.0};
+      const bool finishing = end_stop_applied || stop_seen || operator_done || (safety_.auto_sequence && ever_ran_);
       if (finishing && !machine_.valve_enabled() && machine_.state() != SafetyState::kStopping) {
         if (safety_.auto_sequence && machine_.hydraulics() != HydraulicsStage::kOff &&
             machine_.state() != SafetyState::kFaulted) {
@@ -327,7 +334,9 @@ LoopResult RigLoop::run(const std::atomic<bool>& stop_requested) {
     e.t_ns = prev_t_ns_;
     e.state = machine_.state();
     e.event = end_event;
-    e.source = end_event.code == EventCode::kStopRequested ? EventSource::kSignal : EventSource::kLoop;
+    e.source = end_event.code != EventCode::kStopRequested ? EventSource::kLoop
+               : operator_stopped && !stop_seen               ? EventSource::kOperator
+                                                              : EventSource::kSignal;
     log_event(e);
   }
 

@@ -40,7 +40,8 @@ struct SafetyOptions {
   // No operator (`rigctl run`): reset, hydraulics low, high, arm and start as
   // soon as each is allowed, a controlled stop at max_ticks, and the run ends
   // when the rig is stopped or faulted. Off: only operator commands move the
-  // rig; the run ends at a stop request once the valve is safe.
+  // rig; the run ends at a stop request once the valve is safe, or when an
+  // operator stop has been followed by hydraulics off (state off).
   bool auto_sequence = true;
   int feedback_input = -1;  // the controlled input: arm holds here; -1 = input 0
 };

@@ -37,6 +37,7 @@ CommandReceiver::CommandReceiver(const CommandReceiverOptions& options)
     : channel_(options.channel),
       ack_channel_(options.ack_channel.empty() ? default_ack_channel(options.channel) : options.ack_channel),
       logs_per_second_(options.rejection_logs_per_second),
+      on_rejection_logged_(options.on_rejection_logged),
       verifier_(load_operator_key(options.key_path), options.policy, options.max_senders),
       queue_(options.queue_capacity) {
   if (channel_.empty()) throw std::runtime_error("operator commands: empty command channel name");
@@ -127,7 +128,9 @@ void CommandReceiver::log_rejection(const DecodedCommand& d, int64_t now_utime) 
   // not fill the disk with log lines.
   if (now_utime - log_window_start_ >= 1'000'000) {
     if (suppressed_ > 0) {
-      spdlog::warn("operator commands: {} more rejections not logged individually (see the counters)", suppressed_);
+      const std::string text = fmt::format("{} more rejections not logged individually (see the counters)", suppressed_);
+      spdlog::warn("operator commands: {}", text);
+      if (on_rejection_logged_) on_rejection_logged_(RejectionNote{now_utime, "suppressed", 0, text});
     }
     log_window_start_ = now_utime;
     logged_in_window_ = 0;
@@ -139,8 +142,10 @@ void CommandReceiver::log_rejection(const DecodedCommand& d, int64_t now_utime) 
   }
   ++logged_in_window_;
   // The sender id is shown only once validated: it comes from the network.
-  spdlog::warn("operator command rejected ({}): {} [sender '{}', sequence {}]", to_string(d.reason), d.detail,
-               valid_sender_id(d.sender) ? d.sender : std::string("?"), d.sequence);
+  const std::string text = fmt::format("operator command rejected ({}): {} [sender '{}', sequence {}]", to_string(d.reason),
+                                       d.detail, valid_sender_id(d.sender) ? d.sender : std::string("?"), d.sequence);
+  spdlog::warn("{}", text);
+  if (on_rejection_logged_) on_rejection_logged_(RejectionNote{now_utime, std::string(to_string(d.reason)), d.sequence, text});
 }
 
 }  // namespace rigctl

@@ -9,6 +9,7 @@
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <thread>
@@ -29,6 +30,14 @@ std::string default_command_channel(const std::string& channel_prefix);
 // "<command channel>_ACK", e.g. RIGCTL_OPERATOR_ACK.
 std::string default_ack_channel(const std::string& command_channel);
 
+// One logged rejection (or a summary: reason "suppressed", sequence 0).
+struct RejectionNote {
+  int64_t utime = 0;     // the rig's wall clock when it arrived
+  std::string reason;    // to_string(RejectReason), e.g. "bad_tag"
+  int64_t sequence = 0;  // as received
+  std::string text;      // the log line's text: reason, field at fault, sender
+};
+
 struct CommandReceiverOptions {
   std::string lcm_url;          // required: never LCM's implicit default group
   std::string channel = "RIGCTL_OPERATOR";
@@ -38,6 +47,10 @@ struct CommandReceiverOptions {
   std::size_t queue_capacity = 64;
   std::size_t max_senders = 256;
   int rejection_logs_per_second = 20;  // more in one second are summarised (a flood must not fill the disk)
+  // Also called, on the receiver thread, with each rejection line it logs
+  // (and each summary of those it did not): `rigctl run` writes them into
+  // the event log. Same rate limit as the log. Must not throw.
+  std::function<void(const RejectionNote&)> on_rejection_logged;
 };
 
 class CommandReceiver {
@@ -71,6 +84,7 @@ class CommandReceiver {
   std::string channel_;
   std::string ack_channel_;
   int logs_per_second_;
+  std::function<void(const RejectionNote&)> on_rejection_logged_;
   OperatorVerifier verifier_;
   SpscQueue<OperatorCommand> queue_;
   std::unique_ptr<lcm::LCM> lcm_;

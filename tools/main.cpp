@@ -50,6 +50,10 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--events", run.events_path, "Event log to append to (default: <log>.events; SAFETY.md)");
   run_cmd->add_option("--lcm-url", run.lcm_url, "LCM URL, overrides telemetry.lcm_url (e.g. udpm://239.255.76.67:7667?ttl=1)");
   run_cmd->add_flag("--no-realtime{false}", run.realtime, "Do not try mlockall/SCHED_FIFO");
+  run_cmd->add_flag("--operator", run.operator_mode, "Operator mode whatever safety.auto_sequence says: power up faulted, move only on `rigctl cmd` (docs/deployment.md)");
+  run_cmd->add_option("--key", run.key_path, "Operator key file, overrides operator.key_file (mode 600)");
+  std::vector<std::string> run_fault_texts;
+  run_cmd->add_option("--fault", run_fault_texts, "Inject a fault in the simulated driver, KIND@TIME[:ARG...] (stuck, rail, noise, nan, offset, overrun, supply, burst; SAFETY.md); repeatable");
 
   std::string log_in, csv_out, prefix = "RIGCTL_";
   auto* l2c = app.add_subcommand("log2csv", "Convert a run's LCM log into a CSV run file (shared/spec/measured-data.md)");
@@ -67,6 +71,7 @@ int main(int argc, char** argv) {
   sim_cmd->add_option("--modbus-rtu", sim.modbus_rtu, "Serve Modbus RTU on this serial device")->excludes(modbus_opt);
   sim_cmd->add_option("--can-socket", sim.can_socket, "Serve the CANopen valve on this seqpacket socket path");
   auto* sim_duration_opt = sim_cmd->add_option("--duration", sim_duration, "Stop after this many seconds (default: at SIGINT/SIGTERM)")->check(CLI::PositiveNumber);
+  sim_cmd->add_option("--output-watchdog", sim.output_watchdog_s, "DAQ output watchdog [s]: no write for this long and the outputs go to their safe values; 0: off")->capture_default_str();
   sim_cmd->add_option("--fault", fault_texts, "Inject a fault, KIND@TIME[:ARG...] (silence, drop, late, exception, stuck, rail, heartbeat, emcy); repeatable");
 
   rigctl::CompareOptions compare;
@@ -133,6 +138,7 @@ int main(int argc, char** argv) {
   try {
     if (run_cmd->parsed()) {
       if (duration_opt->count() > 0) run.duration_s = duration;
+      for (const auto& f : run_fault_texts) run.faults.push_back(rigctl::parse_fault_spec(f));
       install_stop_handlers();
       const auto report = rigctl::run_rig(run, g_stop, std::cout);
       return report.loop.final_state == rigctl::RigState::kFaulted ? 3 : 0;

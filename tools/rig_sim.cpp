@@ -1,5 +1,7 @@
 #include "tools/rig_sim.hpp"
 
+#include <chrono>
+
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -73,6 +75,9 @@ class FaultSchedule {
       : faults_(std::move(faults)), started_(faults_.size(), false), ended_(faults_.size(), false), daq_(daq),
         valve_(valve), out_(out) {
     for (const auto& f : faults_) {
+      if (!fault_on_wire(f.kind)) {
+        throw std::invalid_argument("fault '" + f.text + "' is injected in the simulated driver: `rigctl run --fault` with driver: sim");
+      }
       if ((f.kind == FaultKind::kHeartbeat || f.kind == FaultKind::kEmcy) && valve_ == nullptr) {
         throw std::invalid_argument("fault '" + f.text + "' needs the CANopen valve (--can-socket)");
       }
@@ -131,6 +136,7 @@ class FaultSchedule {
       case FaultKind::kEmcy:
         valve_->send_emcy(static_cast<uint16_t>(f.code), static_cast<uint8_t>(f.error_register));
         break;
+      default: break;  // not on the wire: refused by the constructor
     }
   }
 
@@ -211,6 +217,10 @@ void run_rig_sim(const RigSimOptions& o, const std::atomic<bool>& stop, std::ost
   const auto period_ns = static_cast<int64_t>(config.loop.period_s * 1e9 + 0.5);
   const int64_t t0 = clock.now_ns();
   int64_t deadline = t0;
+  double null_since = -1.0;
+  int64_t last_writes = 0;
+  double last_write_t = 0.0;
+  bool watchdog_tripped = false;
   for (int64_t tick = 0;; ++tick) {
     const double t = static_cast<double>(tick) * config.loop.period_s;
     if (stop.load() || (o.duration_s && t >= *o.duration_s)) break;
@@ -224,9 +234,28 @@ void run_rig_sim(const RigSimOptions& o, const std::atomic<bool>& stop, std::ost
       command[0] = valve->spool();
     } else {
       daq.outputs(outputs.data());
+      if (const int64_t w = daq.writes(); w != last_writes) {
+        last_writes = w;
+        last_write_t = t;
+        watchdog_tripped = false;
+      } else if (o.output_watchdog_s > 0.0 && t - last_write_t > o.output_watchdog_s) {
+        if (!watchdog_tripped) {
+          out << "rig-sim: t = " << t << " s: output watchdog: no write for " << o.output_watchdog_s
+              << " s, outputs at their safe values\n";
+          watchdog_tripped = true;
+        }
+        for (std::size_t i = 0; i < outputs.size(); ++i) outputs[i] = daq_config.outputs[i].safe;
+      }
       command[0] = outputs[static_cast<std::size_t>(valve_daq_output)];
     }
     if (!std::isfinite(command[0])) command[0] = 0.0;
+    // Where the final stretch of null commands began: after a fault, the time
+    // the valve reached its safe value as the rig saw it (printed at the end).
+    if (command[0] != 0.0) {
+      null_since = -1.0;
+    } else if (null_since < 0.0) {
+      null_since = t;
+    }
     // Twice a second, what the rig does: lets a person (and the end-to-end
     // tests) see that a fault left the valve at null.
     if (tick % std::max<int64_t>(1, std::llround(0.5 / config.loop.period_s)) == 0) {
@@ -241,6 +270,7 @@ void run_rig_sim(const RigSimOptions& o, const std::atomic<bool>& stop, std::ost
   }
   if (valve) valve.reset();
   daq.stop();
+  if (null_since >= 0.0) out << "rig-sim: valve " << plant->commands()[0].name << " = 0 since t = " << null_since << " s\n";
   out << "rig-sim: stopped\n";
 }
 

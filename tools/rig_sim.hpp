@@ -24,6 +24,11 @@ struct RigSimOptions {
   std::string can_socket;   // seqpacket socket path for the CANopen valve
   std::optional<double> duration_s;  // default: until SIGINT/SIGTERM
   std::vector<FaultSpec> faults;
+  // The DAQ module's output watchdog: no write from the controller for this
+  // long and the outputs go to their `safe:` values until writes resume, as
+  // I/O modules do (a dead link cannot carry the controller's safe command).
+  // 0: off.
+  double output_watchdog_s = 0.1;
 };
 
 // Prints "rig-sim: modbus listening on HOST:PORT" and "rig-sim: canopen

@@ -7,17 +7,22 @@
 #include <ctime>
 #include <filesystem>
 #include <iomanip>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
 #include "config/config_reader.hpp"
 #include "config/rig_config.hpp"
+#include "drivers/sim_driver.hpp"
 #include "rt/event_log.hpp"
 #include "rt/realtime.hpp"
 #include "rt/telemetry_publisher.hpp"
 #include "tools/console_status.hpp"
 #include "tools/log2csv.hpp"
+#include "tools/loop_heartbeat.hpp"
+#include "tools/operator_mode.hpp"
 #include "tools/rig_assembly.hpp"
+#include "tools/service_notify.hpp"
 
 namespace rigctl {
 
@@ -60,13 +65,31 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
   if (options.fast && !rig.driver->simulated()) {
     throw std::runtime_error("--fast needs a simulated driver: '" + config.driver + "' runs real hardware in real time");
   }
+  // Injected faults (drivers/sim_faults.hpp): the config's `faults:`, then --fault.
+  std::vector<FaultSpec> faults = config.faults;
+  faults.insert(faults.end(), options.faults.begin(), options.faults.end());
+  auto* sim = dynamic_cast<SimDriver*>(rig.driver.get());
+  if (!faults.empty()) {
+    if (sim == nullptr) {
+      throw std::runtime_error("faults are injected by the simulated driver (driver: sim); on the wire use `rigctl rig-sim --fault`");
+    }
+    sim->set_faults(faults);
+  }
 
-  const double duration = options.duration_s.value_or(rig.profile_duration_s);
-  if (!(duration > 0.0)) throw std::runtime_error("run duration must be positive");
+  OperatorModeOptions op;
+  op.force = options.operator_mode;
+  op.key_path = options.key_path;
+  const bool operator_run = operator_mode(config, op);
+  if (operator_run) rig.safety.auto_sequence = false;  // --operator overrides the file
+  // Operator mode runs until the operator ends it (stop, then hydraulics off)
+  // or a signal, unless --duration bounds it.
+  const bool unbounded = operator_run && !options.duration_s;
+  const double duration = options.duration_s.value_or(unbounded ? 0.0 : rig.profile_duration_s);
+  if (!unbounded && !(duration > 0.0)) throw std::runtime_error("run duration must be positive");
   LoopOptions loop_options;
   loop_options.period_ns = std::llround(config.loop.period_s * 1e9);
   loop_options.overrun_policy = config.loop.overrun_policy;
-  loop_options.max_ticks = std::llround(duration / config.loop.period_s);
+  loop_options.max_ticks = unbounded ? std::numeric_limits<int64_t>::max() : std::llround(duration / config.loop.period_s);
   loop_options.start_from_input = rig.profile_start_input;
   loop_options.timing_every_ticks = std::max<int64_t>(1, std::llround(config.loop.timing_publish_s / config.loop.period_s));
 
@@ -99,24 +122,42 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
     spdlog::error("{}", text);
     publisher.report_event("log_write_failed", text);
   });
-  if (!config.safety.auto_sequence && options.operator_commands == nullptr) {
-    throw ConfigError(config.file + ": safety.auto_sequence: false needs operator commands, and this run has no "
-                      "command receiver");
+  std::unique_ptr<CommandReceiver> receiver;
+  SpscQueue<OperatorCommand>* commands = options.operator_commands;
+  if (operator_run && commands == nullptr) {
+    op.lcm_url = url;
+    const auto feedback = static_cast<std::size_t>(std::max(0, rig.safety.feedback_input));
+    const auto& inputs = rig.driver->layout().inputs;
+    op.setpoint_unit = feedback < inputs.size() ? inputs[feedback].unit : "";
+    receiver = make_operator_receiver(config, op, events);
+    commands = &receiver->queue();
   }
+  // Counts the loop's ticks for the systemd watchdog (a no-op outside systemd).
+  LoopHeartbeat heartbeat(publisher);
+  ServiceNotifier notifier(heartbeat.beats());
 
   rig.driver->start();
   publisher.start();  // before the real-time set-up: the publisher keeps normal priority
   events.start();
+  // Threads started before the RealtimeSession keep normal priority.
+  if (receiver) receiver->start();
+  notifier.start();
 
   out << "rigctl run: " << config.rig << " (" << config.driver << " driver) from " << options.config_path
       << (options.case_name.empty() ? "" : " case " + options.case_name) << ", "
-      << duration << " s " << (options.fast ? "as fast as possible" : "paced by the real clock") << "\n"
+      << (unbounded ? std::string("until stopped") : fmt::format("{:g} s", duration)) << " "
+      << (options.fast ? "as fast as possible" : "paced by the real clock") << "\n"
       << "  telemetry: " << url << " channels " << config.telemetry.channel_prefix << "*\n";
+  if (receiver) {
+    out << "  operator mode: the rig powers up faulted; commands on " << receiver->channel() << " (acks on "
+        << receiver->ack_channel() << ")\n";
+  }
   out.flush();
 
   MonotonicClock monotonic;
   VirtualClock virtual_clock;
   LoopClock& clock = options.fast ? static_cast<LoopClock&>(virtual_clock) : monotonic;
+  if (sim != nullptr) sim->set_stall_clock(&clock);  // an overrun fault stalls the loop's own clock
 
   const auto wall_start = std::chrono::steady_clock::now();
   LoopResult result;
@@ -132,15 +173,18 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
     }
     std::optional<ConsoleStatus> status;
     if (!options.fast) {
-      status.emplace(publisher, meta, rig.driver->layout().input_index(config.controller.feedback), duration, out);
+      status.emplace(publisher, meta, rig.driver->layout().input_index(config.controller.feedback),
+                   unbounded ? std::numeric_limits<double>::infinity() : duration, out);
     }
-    RigLoop loop(*rig.driver, *rig.controller, *rig.profile, rig.detectors, publisher, clock, loop_options,
+    RigLoop loop(*rig.driver, *rig.controller, *rig.profile, rig.detectors, heartbeat, clock, loop_options,
                  rig.safety);
     loop.set_event_sink(&events);
-    loop.set_operator_commands(options.operator_commands);
+    loop.set_operator_commands(commands);
     try {
       result = loop.run(stop);
     } catch (...) {
+      notifier.stop("control loop failed");
+      if (receiver) receiver->stop();
       events.stop();
       publisher.stop();  // keep what was recorded
       rig.driver->stop();
@@ -148,6 +192,8 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
     }
   }
   report.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  notifier.stop("control loop ended, closing the logs");
+  if (receiver) receiver->stop();  // before the event log closes: its last rejections go in
   events.stop();
   publisher.stop();
   rig.driver->stop();
@@ -179,6 +225,7 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
   out << "  events: " << report.events_path << " (" << es.written << " lines, " << std::setprecision(2)
       << "longest write+fsync " << es.max_fsync_ms << " ms" << (es.pending > 0 ? ", " + std::to_string(es.pending) + " NOT WRITTEN" : "")
       << ")\n";
+  if (receiver) out << "  operator commands: " << describe_counters(receiver->counters()) << "\n";
   if (publisher.log_failures() > 0) out << "  run log write failures: " << publisher.log_failures() << "\n";
   if (!report.csv_path.empty()) {
     const auto csv = log_to_csv(report.log_path, report.csv_path, config.telemetry.channel_prefix);

@@ -6,25 +6,32 @@
 #include <optional>
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include "config/rig_config.hpp"
 #include "rt/rig_loop.hpp"
+#include "tools/fault_spec.hpp"
 
 namespace rigctl {
 
 struct RunOptions {
   std::string config_path;
   std::string case_name;             // a `cases:` entry of the config, "" for none
-  std::optional<double> duration_s;  // default: the profile's length
+  std::optional<double> duration_s;  // default: the profile's length; operator mode: until the operator ends it
   bool fast = false;                 // simulated plant only: no pacing
   std::string log_path;              // default: <log_dir>/<rig>-<time>.lcm
   std::string events_path;           // event log; default: <log_path>.events
   std::string csv_path;              // optional run-file CSV
   std::string lcm_url;               // overrides telemetry.lcm_url
   bool realtime = true;              // false: skip mlockall/SCHED_FIFO (tests)
-  // Operator commands (the LCM command receiver pushes them); nullptr: none.
-  // With `safety.auto_sequence: false` the rig then moves only on these.
+  // Operator commands from a caller's own source (tests); nullptr: in
+  // operator mode run_rig opens the LCM command receiver itself
+  // (tools/operator_mode.hpp). The rig then moves only on these.
   SpscQueue<OperatorCommand>* operator_commands = nullptr;
+  bool operator_mode = false;  // --operator: safety.auto_sequence taken as false
+  std::string key_path;        // --key: overrides operator.key_file
+  // --fault KIND@TIME[:ARG...], after the config's `faults:`; simulated driver only (drivers/sim_faults.hpp).
+  std::vector<FaultSpec> faults;
 };
 
 struct RunReport {

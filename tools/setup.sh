@@ -11,7 +11,8 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 packages=(cmake g++ make pkg-config liblcm-dev liblcm-bin libglib2.0-dev libmodbus-dev libspdlog-dev
           libfmt-dev libeigen3-dev libgtest-dev libgmock-dev libsocketcan-dev libyaml-cpp-dev libcli11-dev libnlopt-cxx-dev libceres-dev
           libboost-dev libbenchmark-dev rt-tests iproute2 socat
-          libssl-dev)  # libssl-dev: libcrypto HMAC-SHA256 for operator commands
+          libssl-dev   # libssl-dev: libcrypto HMAC-SHA256 for operator commands
+          libsystemd-dev)  # sd_notify: the service's readiness and watchdog (docs/deployment.md)
 for arg in "$@"; do
   case "$arg" in
     --plots) packages+=(python3 python3-numpy python3-matplotlib) ;;

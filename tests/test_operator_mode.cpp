@@ -1,0 +1,212 @@
+// `rigctl run --operator` end to end (issue 7): the rig powers up faulted and
+// moves only on `rigctl cmd`, over the real udpm:// provider inside a network
+// namespace this test creates (never multicast on the host's interfaces).
+// Every state change is in the event log in order, a forbidden command is
+// refused with its reason, a forged one (wrong key) changes nothing and is
+// counted, and stop then hydraulics-off ends the run (exit 0).
+#include <gtest/gtest.h>
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <thread>
+
+#include "background_process.hpp"
+#include "config/config_reader.hpp"
+#include "config/rig_config.hpp"
+#include "process.hpp"
+
+namespace fs = std::filesystem;
+using rigctl::test::BackgroundProcess;
+using rigctl::test::run_command;
+
+namespace {
+
+const std::string kRigctl = RIGCTL_BINARY;
+const std::string kConfig = std::string(RIGCTL_SOURCE_DIR) + "/config/quarter_car.yaml";
+const std::string kUrl = "udpm://239.255.76.67:7667?ttl=0";
+
+std::string read_file(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+void write_key(const fs::path& p, char fill) {
+  std::ofstream(p) << std::string(32, fill);
+  fs::permissions(p, fs::perms::owner_read | fs::perms::owner_write, fs::perm_options::replace);
+}
+
+// "from -> to" of every state_changed line, in file order.
+std::vector<std::string> state_changes(const std::string& events) {
+  std::vector<std::string> out;
+  const std::regex re("code=state_changed .*message=\"([a-z_]+ -> [a-z_]+)\"");
+  std::istringstream in(events);
+  for (std::string line; std::getline(in, line);) {
+    std::smatch m;
+    if (std::regex_search(line, m, re)) out.push_back(m[1]);
+  }
+  return out;
+}
+
+class OperatorMode : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (::geteuid() != 0) GTEST_SKIP() << "needs root to create a network namespace";
+    if (run_command("ip -V").exit_code != 0) GTEST_SKIP() << "no 'ip' program (iproute2) on PATH";
+    ns_ = "rigctl-opmode-" + std::to_string(::getpid());
+    for (const std::string& step : {"ip netns add " + ns_, "ip netns exec " + ns_ + " ip link set lo up",
+                                    "ip netns exec " + ns_ + " ip link set lo multicast on",
+                                    "ip netns exec " + ns_ + " ip route add 224.0.0.0/4 dev lo"}) {
+      const auto r = run_command(step);
+      if (r.exit_code != 0) GTEST_SKIP() << "cannot set up a network namespace: '" << step << "': " << r.output;
+      if (step.rfind("ip netns add", 0) == 0) ns_created_ = true;
+    }
+    dir_ = fs::temp_directory_path() / ("rigctl_opmode_" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+    key_ = (dir_ / "rig.key").string();
+    wrong_key_ = (dir_ / "wrong.key").string();
+    write_key(key_, 'k');
+    write_key(wrong_key_, 'w');
+    events_ = dir_ / "run.lcm.events";
+  }
+  void TearDown() override {
+    if (!dir_.empty()) fs::remove_all(dir_);
+    if (ns_created_ && run_command("ip netns del " + ns_).exit_code != 0) ADD_FAILURE() << "could not delete netns " << ns_;
+  }
+
+  std::string in_ns(const std::string& command) const { return "ip netns exec " + ns_ + " " + command; }
+
+  rigctl::test::ProcessResult cmd(const std::string& command, const std::string& key) const {
+    return run_command(in_ns(kRigctl + " cmd " + command + " --key " + key + " --lcm-url '" + kUrl +
+                             "' --sender tester --wait-ack 5 --state-file " + (dir_ / "tester.seq").string()));
+  }
+
+  // Waits until the event log contains `text` (the writer fsyncs each line
+  // within a millisecond or so of the event).
+  bool wait_event(const std::string& text) const {
+    for (int i = 0; i < 1000; ++i) {
+      if (read_file(events_).find(text) != std::string::npos) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return false;
+  }
+
+  std::string ns_;
+  bool ns_created_ = false;
+  fs::path dir_, events_;
+  std::string key_, wrong_key_;
+};
+
+TEST_F(OperatorMode, CommandsDriveTheRigThroughEveryStateAndEndIt) {
+  BackgroundProcess rig({"/bin/sh", "-c",
+                         "exec " + in_ns(kRigctl + " run " + kConfig + " --operator --key " + key_ + " --lcm-url '" +
+                                         kUrl + "' --log " + (dir_ / "run.lcm").string() + " --no-realtime")},
+                        (dir_ / "rig.out").string());
+  ASSERT_TRUE(rig.wait_for("listening on RIGCTL_OPERATOR", 30.0)) << rig.output();
+  ASSERT_TRUE(wait_event("code=run_started")) << rig.output();
+  // Powered up faulted: nothing has moved.
+  EXPECT_NE(read_file(events_).find("state=faulted code=run_started"), std::string::npos) << read_file(events_);
+
+  auto step = [&](const std::string& command, const std::string& change) {
+    const auto r = cmd(command, key_);
+    ASSERT_EQ(r.exit_code, 0) << command << ": " << r.output;
+    ASSERT_TRUE(wait_event("message=\"" + change + "\"")) << command << " did not give " << change << "\n"
+                                                                << read_file(events_) << rig.output();
+  };
+
+  step("reset", "faulted -> off");
+  // Forbidden: start while off. The receiver accepts it (authentic), the
+  // state machine refuses it with its reason.
+  {
+    const auto r = cmd("start", key_);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    ASSERT_TRUE(wait_event("message=\"start refused: ")) << read_file(events_);
+    const std::string ev = read_file(events_);
+    const std::smatch m = [&] {
+      std::smatch mm;
+      std::regex_search(ev, mm, std::regex("state=off code=command_rejected .*source=operator .*message=\"start refused: ([^\"]+)\""));
+      return mm;
+    }();
+    ASSERT_FALSE(m.empty()) << ev;
+    EXPECT_FALSE(m[1].str().empty());
+  }
+  step("hydraulics-low", "off -> hydraulics_low");
+  step("hydraulics-high", "hydraulics_low -> hydraulics_high");
+  // Forged: the wrong key. `rigctl cmd` cannot verify the rig's reply (exit
+  // 4), the rig logs bad_tag and stays where it was.
+  {
+    const std::size_t changes_before = state_changes(read_file(events_)).size();
+    const auto r = cmd("arm", wrong_key_);
+    EXPECT_EQ(r.exit_code, 4) << r.output;
+    ASSERT_TRUE(wait_event("source=receiver")) << read_file(events_) << rig.output();
+    const std::string ev = read_file(events_);
+    EXPECT_NE(ev.find("code=command_rejected source=receiver"), std::string::npos) << ev;
+    EXPECT_NE(ev.find("bad_tag"), std::string::npos) << ev;
+    EXPECT_EQ(state_changes(ev).size(), changes_before) << ev;
+  }
+  step("arm", "hydraulics_high -> armed");
+  step("start", "armed -> running");
+  step("hold", "running -> holding");
+  step("resume", "holding -> running");
+  step("stop", "running -> stopping");
+  ASSERT_TRUE(wait_event("message=\"stopping -> hydraulics_high\"")) << read_file(events_);
+  step("hydraulics-off", "hydraulics_high -> off");
+
+  // Stop followed by hydraulics off ends the run by itself.
+  const int status = rig.wait();
+  const std::string out = rig.output();
+  EXPECT_EQ(status, 0) << out;
+  EXPECT_NE(out.find("ended: stopped (stop_requested)"), std::string::npos) << out;
+  // 10 authentic commands reached the loop (one refused there), 1 forged.
+  EXPECT_NE(out.find("operator commands: 10 accepted, 1 rejected (bad_tag 1)"), std::string::npos) << out;
+
+  const std::vector<std::string> expected{
+      "faulted -> off",           "off -> hydraulics_low",   "hydraulics_low -> hydraulics_high",
+      "hydraulics_high -> armed", "armed -> running",        "running -> holding",
+      "holding -> running",       "running -> stopping",     "stopping -> hydraulics_high",
+      "hydraulics_high -> off"};
+  const std::string ev = read_file(events_);
+  EXPECT_EQ(state_changes(ev), expected) << ev;
+  EXPECT_NE(ev.find("# closed cleanly"), std::string::npos) << ev;
+}
+
+TEST(OperatorModeConfig, WithoutAKeyTheRunRefusesNamingTheField) {
+  // The shipped config's key file (config/operator.key) is not in the tree.
+  const auto r = run_command(kRigctl + " run " + kConfig + " --operator --fast --duration 0.1 --log /dev/null --events /dev/null");
+  EXPECT_NE(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("operator.key"), std::string::npos) << r.output;
+}
+
+// The `operator:` section is read strictly: each error names its field.
+std::string config_error(const std::string& from, const std::string& to) {
+  std::string text = read_file(kConfig);
+  const auto at = text.find(from);
+  if (at == std::string::npos) return "config text '" + from + "' not found";
+  text.replace(at, from.size(), to);
+  try {
+    rigctl::parse_rig_config(text, kConfig);
+  } catch (const rigctl::ConfigError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(OperatorModeConfig, ReaderNamesTheBadField) {
+  EXPECT_NE(config_error("  staleness_s: 2.0", "  staleness_s: 2.0\n  bogus: 1").find("operator.bogus"), std::string::npos);
+  EXPECT_NE(config_error("  key_file: operator.key", "").find("operator.key_file"), std::string::npos);
+  EXPECT_NE(config_error("  staleness_s: 2.0", "  staleness_s: 600").find("operator.staleness_s"), std::string::npos);
+  EXPECT_NE(config_error("  channel: RIGCTL_OPERATOR", "  channel: \"A.*\"").find("operator.channel"), std::string::npos);
+  // Relative key paths are taken from the config's folder.
+  const auto c = rigctl::parse_rig_config(read_file(kConfig), kConfig);
+  EXPECT_EQ(c.operator_commands.key_file, (fs::path(kConfig).parent_path() / "operator.key").string());
+  EXPECT_DOUBLE_EQ(c.operator_commands.staleness_s, 2.0);
+}
+
+}  // namespace
