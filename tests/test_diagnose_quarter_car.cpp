@@ -4,16 +4,15 @@
 // tolerance of the truth, and show a positive held-out gain. The generator's
 // physics is not the candidate's formula (plant/quarter_car_params.hpp,
 // QuarterCarHiddenEffects), so the tolerances compare physically equivalent
-// quantities. All runs and diagnoses are made once, two at a time.
+// quantities.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <filesystem>
-#include <functional>
+#include <algorithm>
 #include <map>
 #include <mutex>
 #include <sstream>
-#include <thread>
 
 #include "plant/bearing_friction.hpp"
 #include "plant/quarter_car_params.hpp"
@@ -77,39 +76,24 @@ Outcome run_case(const Case& c, const std::string& dir) {
   return o;
 }
 
-const std::map<std::string, Outcome>& outcomes() {
-  static const std::map<std::string, Outcome> all = [] {
+// Each case is made and diagnosed on first use: ctest runs every TEST in a
+// process of its own (gtest_discover_tests), and ctest -j spreads them over
+// the cores, so a TEST computes only the cases it checks.
+const Outcome& outcome(const std::string& name) {
+  static std::map<std::string, Outcome> done;
+  static std::mutex m;
+  std::lock_guard<std::mutex> lock(m);
+  auto it = done.find(name);
+  if (it == done.end()) {
+    const auto c = std::find_if(cases().begin(), cases().end(), [&](const Case& k) { return k.name == name; });
+    if (c == cases().end()) throw std::invalid_argument("no case " + name);
     const std::string dir = std::filesystem::temp_directory_path() / ("rigctl_qc_hidden_" + std::to_string(getpid()));
     std::filesystem::create_directories(dir);
-    std::map<std::string, Outcome> out;
-    std::mutex m;
-    std::size_t next = 0;
-    auto worker = [&] {
-      for (;;) {
-        std::size_t i;
-        {
-          std::lock_guard<std::mutex> lock(m);
-          if (next >= cases().size()) return;
-          i = next++;
-        }
-        Outcome o = run_case(cases()[i], dir);
-        std::lock_guard<std::mutex> lock(m);
-        out[cases()[i].name] = std::move(o);
-      }
-    };
-    std::thread a(worker), b(worker);
-    a.join();
-    b.join();
+    it = done.emplace(name, run_case(*c, dir)).first;
     std::filesystem::remove_all(dir);
-    return out;
-  }();
-  return all;
-}
-
-const Outcome& outcome(const std::string& name) {
-  const Outcome& o = outcomes().at(name);
-  EXPECT_TRUE(o.error.empty()) << name << ": " << o.error;
-  return o;
+  }
+  EXPECT_TRUE(it->second.error.empty()) << name << ": " << it->second.error;
+  return it->second;
 }
 
 const diag::CauseResult* found(const Outcome& o, const std::string& cause) {
@@ -145,7 +129,9 @@ const diag::CauseResult* expect_named(const std::string& case_name, const std::s
   const Outcome& o = outcome(case_name);
   EXPECT_EQ(o.diagnosis.cause, cause) << summary(o);
   const auto* c = found(o, cause);
-  if (c) EXPECT_GT(c->gain_percent_points, 0.0) << summary(o);
+  if (c) {
+    EXPECT_GT(c->gain_percent_points, 0.0) << summary(o);
+  }
   return c;
 }
 
