@@ -7,6 +7,8 @@
 // CPU: every run is generated first (separate processes), then the diagnoses
 // run two at a time in threads (CI has two cores).
 #include <gtest/gtest.h>
+
+#include <algorithm>
 #include <unistd.h>
 
 #include <array>
@@ -91,29 +93,12 @@ std::map<std::string, double> read_truth(const std::string& path) {
 
 class DiagnoseHalfCar : public ::testing::Test {
  protected:
+  // Runs are made and diagnosed on first use, one case at a time: ctest
+  // runs every TEST in a process of its own (gtest_discover_tests), so a
+  // suite-wide set-up would redo every case once per test.
   static void SetUpTestSuite() {
     dir_ = fs::temp_directory_path() / ("rigctl_diag_half_car_" + std::to_string(::getpid()));
     fs::create_directories(dir_);
-    // Generate every run (each make-run is its own process; two at a time).
-    std::vector<std::future<void>> jobs;
-    for (std::size_t i = 0; i < kCases.size(); ++i) {
-      if (jobs.size() == 2) {
-        jobs.front().get();
-        jobs.erase(jobs.begin());
-      }
-      jobs.push_back(std::async(std::launch::async, [i] { make(kCases[i]); }));
-    }
-    for (auto& j : jobs) j.get();
-    // Diagnose two at a time.
-    std::vector<std::future<void>> diags;
-    for (std::size_t i = 0; i < kCases.size(); ++i) {
-      if (diags.size() == 2) {
-        diags.front().get();
-        diags.erase(diags.begin());
-      }
-      diags.push_back(std::async(std::launch::async, [i] { diagnose(kCases[i]); }));
-    }
-    for (auto& j : diags) j.get();
   }
   static void TearDownTestSuite() {
     std::error_code ec;
@@ -148,6 +133,17 @@ class DiagnoseHalfCar : public ::testing::Test {
   }
 
   static const Outcome& outcome(const std::string& name) {
+    bool known;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      known = outcomes_.count(name) > 0;
+    }
+    if (!known) {
+      const auto c = std::find_if(kCases.begin(), kCases.end(), [&](const Case& k) { return k.name == name; });
+      if (c == kCases.end()) throw std::invalid_argument("no case " + name);
+      make(*c);
+      diagnose(*c);
+    }
     const Outcome& o = outcomes_.at(name);
     EXPECT_TRUE(o.made) << o.make_output;
     return o;

@@ -4,17 +4,18 @@
 // tolerance of the truth, and show a positive held-out gain. The generator's
 // physics is not the candidate's formula (plant/quarter_car_params.hpp,
 // QuarterCarHiddenEffects), so the tolerances compare physically equivalent
-// quantities. All runs and diagnoses are made once, two at a time.
+// quantities.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <filesystem>
-#include <functional>
+#include <algorithm>
 #include <map>
 #include <mutex>
 #include <sstream>
-#include <thread>
 
+#include "plant/bearing_friction.hpp"
+#include "plant/quarter_car_params.hpp"
 #include "tools/diag_engine.hpp"
 #include "tools/diag_model.hpp"
 #include "tools/hidden_effects.hpp"
@@ -75,39 +76,24 @@ Outcome run_case(const Case& c, const std::string& dir) {
   return o;
 }
 
-const std::map<std::string, Outcome>& outcomes() {
-  static const std::map<std::string, Outcome> all = [] {
+// Each case is made and diagnosed on first use: ctest runs every TEST in a
+// process of its own (gtest_discover_tests), and ctest -j spreads them over
+// the cores, so a TEST computes only the cases it checks.
+const Outcome& outcome(const std::string& name) {
+  static std::map<std::string, Outcome> done;
+  static std::mutex m;
+  std::lock_guard<std::mutex> lock(m);
+  auto it = done.find(name);
+  if (it == done.end()) {
+    const auto c = std::find_if(cases().begin(), cases().end(), [&](const Case& k) { return k.name == name; });
+    if (c == cases().end()) throw std::invalid_argument("no case " + name);
     const std::string dir = std::filesystem::temp_directory_path() / ("rigctl_qc_hidden_" + std::to_string(getpid()));
     std::filesystem::create_directories(dir);
-    std::map<std::string, Outcome> out;
-    std::mutex m;
-    std::size_t next = 0;
-    auto worker = [&] {
-      for (;;) {
-        std::size_t i;
-        {
-          std::lock_guard<std::mutex> lock(m);
-          if (next >= cases().size()) return;
-          i = next++;
-        }
-        Outcome o = run_case(cases()[i], dir);
-        std::lock_guard<std::mutex> lock(m);
-        out[cases()[i].name] = std::move(o);
-      }
-    };
-    std::thread a(worker), b(worker);
-    a.join();
-    b.join();
+    it = done.emplace(name, run_case(*c, dir)).first;
     std::filesystem::remove_all(dir);
-    return out;
-  }();
-  return all;
-}
-
-const Outcome& outcome(const std::string& name) {
-  const Outcome& o = outcomes().at(name);
-  EXPECT_TRUE(o.error.empty()) << name << ": " << o.error;
-  return o;
+  }
+  EXPECT_TRUE(it->second.error.empty()) << name << ": " << it->second.error;
+  return it->second;
 }
 
 const diag::CauseResult* found(const Outcome& o, const std::string& cause) {
@@ -143,7 +129,9 @@ const diag::CauseResult* expect_named(const std::string& case_name, const std::s
   const Outcome& o = outcome(case_name);
   EXPECT_EQ(o.diagnosis.cause, cause) << summary(o);
   const auto* c = found(o, cause);
-  if (c) EXPECT_GT(c->gain_percent_points, 0.0) << summary(o);
+  if (c) {
+    EXPECT_GT(c->gain_percent_points, 0.0) << summary(o);
+  }
   return c;
 }
 
@@ -154,14 +142,26 @@ TEST(HiddenEffectsQuarterCar, CleanRunGivesNone) {
 }
 
 TEST(HiddenEffectsQuarterCar, BearingFriction) {
+  // The sliding friction at 5 cm/s (a typical body speed of the diagnosis
+  // run) and the static normal force: the Karnopp truth's Stribeck law
+  // against the fitted one. Breakaway itself is poorly excited by a run that
+  // keeps the body moving (the fit may put the stiction excess to 0).
+  QuarterCarParams nominal;
+  const auto& bf = nominal.bearing_friction;
+  const double weight = nominal.mass_body * nominal.gravity;
+  const double fn = bearing_friction_levels(bf, weight, 0.0, 0.0).normal;
+  const double v = 0.05;
+  const double stribeck = std::exp(-std::pow(v / bf.stribeck_velocity, bf.stribeck_exponent));
   for (const char* name : {"bearing_friction_strong", "bearing_friction_weak"}) {
     const auto* c = expect_named(name, "bearing_friction");
     if (!c) continue;
-    // Breakaway: Karnopp's F_c0 + dF_s (plus the normal-force part, a few N)
-    // against the fitted Coulomb + stiction excess.
     const Outcome& o = outcome(name);
-    const double want = truth(o, "bearing_friction", "Fc") + truth(o, "bearing_friction", "dFs");
-    EXPECT_NEAR(fitted(*c, "Fc") + fitted(*c, "dFs"), want, 0.5 * want) << name;
+    const double level = o.applied.front().level;
+    const double want = truth(o, "bearing_friction", "Fc") + bf.normal_coefficient * level * fn +
+                        truth(o, "bearing_friction", "dFs") * stribeck + truth(o, "bearing_friction", "D") * v;
+    const double got = fitted(*c, "Fc") + fitted(*c, "mu") * fn + fitted(*c, "dFs") * std::exp(-std::pow(v / 0.015, 2)) +
+                       fitted(*c, "D") * v;
+    EXPECT_NEAR(got, want, 0.4 * want) << name << " (static normal force " << fn << " N)";
   }
 }
 

@@ -206,11 +206,11 @@ Diagnosis diagnose(const RigModel& model, const DiagnoseOptions& opt) {
     for (std::size_t e = 0; e < effects.size(); ++e) {
       if (tried[e] || std::find(active.begin(), active.end(), e) != active.end()) continue;
       say("round " + std::to_string(round) + ": screening " + effects[e].cause);
-      // Screening frees only the candidate's own parameters (baseline and
-      // effects already kept stay where the current fit put them): a cheap
-      // measure of how much the effect alone can explain; the best few are
-      // then refitted with everything free.
-      std::vector<bool> free(L.specs.size(), false);
+      // Screening frees the candidate's parameters and the baseline's (the
+      // baseline fit has bent its parameters to mimic the missing effect, so
+      // they must be able to move back); effects already kept stay where the
+      // current fit put them. The best few are then refitted with all free.
+      std::vector<bool> free = free_for({});
       for (std::size_t j = 0; j < effects[e].params.size(); ++j) free[L.offset[e] + j] = true;
       std::vector<std::vector<double>> starts;
       std::vector<double> st = current.theta;
@@ -467,6 +467,16 @@ Diagnosis diagnose(const RigModel& model, const DiagnoseOptions& opt) {
     const auto fr = free_for(active);
     for (std::size_t i = 0; i < L.specs.size(); ++i)
       if (fr[i]) d.final_parameters.push_back({L.specs[i].name, L.specs[i].unit, current.theta[i], current.sigma.empty() ? 0.0 : current.sigma[i]});
+    // Each named cause reports its parameters from the final joint fit: the
+    // values of the round that accepted it were fitted without the effects
+    // added later, which may have carried part of its work.
+    for (auto& cr : d.causes)
+      for (auto e : active)
+        if (effects[e].cause == cr.cause)
+          for (std::size_t j = 0; j < cr.parameters.size() && j < effects[e].params.size(); ++j) {
+            cr.parameters[j].value = current.theta[L.offset[e] + j];
+            if (!current.sigma.empty()) cr.parameters[j].sigma = current.sigma[L.offset[e] + j];
+          }
   }
   for (std::size_t o = 0; o < outs.size(); ++o) {
     d.baseline_fit_percent[outs[o].name] = base.fit[o];

@@ -98,7 +98,7 @@ int main(int argc, char** argv) {
 
   rigctl::DiagnoseCommandOptions diag;
   auto* diag_cmd = app.add_subcommand("diagnose", "Model-discrepancy diagnosis of a run file (shared/spec/measured-data.md)");
-  diag_cmd->add_option("--rig", diag.rig, "Rig kind: linear_axis, damper, quarter_car")->required();
+  diag_cmd->add_option("--rig", diag.rig, "Rig kind: quarter_car, pneumatic_rotary, half_car, linear_axis, damper")->required();
   diag_cmd->add_option("--data", diag.data_path, "Run file (CSV)")->required();
   diag_cmd->add_option("--config", diag.config_path, "Rig config (default: nominal parameters)");
   diag_cmd->add_option("--json", diag.json_path, "Write the diagnosis as JSON");

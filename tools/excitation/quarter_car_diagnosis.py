@@ -88,12 +88,15 @@ def write(name, segs, what):
 write("quarter_car_diagnosis_demand.csv", segments, "Demand of the quarter car's diagnosis runs")
 
 # The lift-off variant: the same table with a burst at the wheel-hop
-# frequency (sqrt(kt / Mw) / 2 pi = 24 Hz) in the middle. The closed loop
+# frequency (sqrt(kt / Mw) / 2 pi = 24 Hz) in the middle, +-20 mm. The closed loop
 # cannot follow it, but the rod moves at the valve's full flow and the wheel
 # resonates: the tyre load swings by more than the static 2.7 kN, so a tyre
 # that cannot pull leaves the plate. Nothing in the clean table does that
 # (the lowest tyre load there is about 0.3 kN).
-segments_liftoff = list(segments[:11])
-segments_liftoff.append((1.2, lambda t: MID + 0.006 * min(1.0, t / 0.1, (1.2 - t) / 0.1) * math.sin(2 * math.pi * 24.0 * t)))
-segments_liftoff.extend(segments[11:])
+def wheel_hop_burst():
+    return (1.2, lambda t: MID + 0.020 * min(1.0, t / 0.1, (1.2 - t) / 0.1) * math.sin(2 * math.pi * 24.0 * t))
+
+
+# Two bursts: one in the part the diagnosis fits, one in the last 20 % it holds out.
+segments_liftoff = segments[:11] + [wheel_hop_burst()] + segments[11:15] + [wheel_hop_burst()] + segments[15:]
 write("quarter_car_liftoff_demand.csv", segments_liftoff, "Demand of the quarter car's lift-off runs (a wheel-hop burst added)")
