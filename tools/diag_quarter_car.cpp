@@ -111,6 +111,7 @@ class QuarterCarModel : public RigModel {
     vb_ = run.has("v_b") ? run.col("v_b") : central_diff(run.col("x_b"), dt_);
     vw_ = run.has("v_w") ? run.col("v_w") : central_diff(xw_, dt_);
     outputs_ = {{"x_b", run.col("x_b")}, {"x_w", xw_}, {"u", run.col("u")}, {"x_r", xr_}};
+    if (run.has("f_t")) ft_ = run.col("f_t");
     if (run.has("p1") && run.has("p2")) {
       outputs_.push_back({"p1", run.col("p1")});
       outputs_.push_back({"p2", run.col("p2")});
@@ -188,6 +189,14 @@ class QuarterCarModel : public RigModel {
     if (cause == "actuator_seal_friction") return {"rod velocity v_r [m/s]", vr_};
     if (cause == "valve_deadband" || cause == "cross_port_leakage") return {"valve command u [1]", outputs_[2].measured};
     if (cause == "entrained_air") return {"x_r [m]", xr_};
+    if (cause == "tyre_liftoff") {
+      // Lift-off happens where the tyre load reaches 0: the measured load
+      // cell where the run has one, else the tyre's deflection.
+      if (!ft_.empty()) return {"tyre load f_t [N]", ft_};
+      std::vector<double> d(xr_.size());
+      for (std::size_t i = 0; i < d.size(); ++i) d[i] = xr_[i] - xw_[i];
+      return {"tyre deflection x_r - x_w [m]", d};
+    }
     return {"body velocity v_b [m/s]", vb_};
   }
   std::vector<double> effect_term(const std::string& cause, const std::vector<double>& th) const override {
@@ -333,7 +342,7 @@ class QuarterCarModel : public RigModel {
     }
   }
 
-  std::vector<double> t_, xref_, xr_, vr_, xw_, vb_, vw_;
+  std::vector<double> t_, xref_, xr_, vr_, xw_, vb_, vw_, ft_;
   double dt_;
   QuarterCarParams p_;
   PiConfig pi_;

@@ -18,8 +18,8 @@ struct SweepOptions {
   std::string config_path;             // default config/<rig>.yaml
   std::vector<std::string> causes;     // empty: every cause id of the rig
   std::vector<double> levels{0.35, 1.0};
-  std::vector<int> seeds{11, 12};
-  int clean_runs = 4;                  // runs with nothing hidden (expect "none")
+  std::vector<int> seeds{11};
+  int clean_runs = 3;                  // runs with nothing hidden (expect "none")
   int threads = 2;
   double duration_s = 0.0;             // 0: the excitation's length
   std::string scratch_dir;             // run files go here
