@@ -45,11 +45,19 @@ ConfigReader::ConfigReader(YAML::Node node, std::shared_ptr<const std::string> f
       used_(std::make_shared<std::set<std::string>>()) {}
 
 namespace {
+// A case that changes a section's `type` gives another kind of section: it
+// replaces the section whole (a csv profile shares no keys with a
+// ramp_steps one, and the strict reader would refuse the leftovers).
+bool retyped(const YAML::Node& base, const YAML::Node& overlay) {
+  const YAML::Node a = base["type"], b = overlay["type"];
+  return a && b && a.IsScalar() && b.IsScalar() && a.Scalar() != b.Scalar();
+}
+
 void merge_into(YAML::Node target, const YAML::Node& overlay, const std::string& file) {
   for (const auto& kv : overlay) {
     const auto key = key_text(kv.first, file, "cases");
     YAML::Node existing = target[key];
-    if (kv.second.IsMap() && existing.IsMap()) {
+    if (kv.second.IsMap() && existing.IsMap() && !retyped(existing, kv.second)) {
       merge_into(existing, kv.second, file);
     } else {
       target[key] = YAML::Clone(kv.second);

@@ -22,7 +22,7 @@
 #include "rt/pvp_controller.hpp"
 #include "rt/realtime.hpp"
 #include "rt/timing_stats.hpp"
-#include "tools/fault_spec.hpp"
+#include "drivers/fault_spec.hpp"
 
 namespace rigctl {
 

@@ -11,14 +11,7 @@ SensorModel::SensorModel(const SensorSpec& spec) : spec_(spec) {
 
 double SensorModel::measure(double truth, std::mt19937_64& rng) const noexcept {
   double v = truth + spec_.offset;
-  if (spec_.noise_sd > 0.0) {
-    // Box-Muller by hand: std::normal_distribution keeps hidden state and its
-    // output differs between standard libraries; this is the same everywhere.
-    constexpr double kTwoPi = 6.283185307179586;
-    const double u1 = (static_cast<double>(rng() >> 11) + 0.5) * 0x1.0p-53;
-    const double u2 = static_cast<double>(rng() >> 11) * 0x1.0p-53;
-    v += spec_.noise_sd * std::sqrt(-2.0 * std::log(u1)) * std::cos(kTwoPi * u2);
-  }
+  if (spec_.noise_sd > 0.0) v += spec_.noise_sd * standard_normal(rng);
   if (spec_.bits > 0) {
     v = std::clamp(v, spec_.range_min, spec_.range_max);
     v = spec_.range_min + std::round((v - spec_.range_min) / lsb_) * lsb_;

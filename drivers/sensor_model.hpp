@@ -2,6 +2,7 @@
 // clipping to the range and quantisation to the converter's resolution.
 #pragma once
 
+#include <cmath>
 #include <random>
 
 namespace rigctl {
@@ -17,6 +18,16 @@ struct SensorSpec {
   // not the linear interpolation the diagnosis fits). 0 = none.
   double delay_s = 0.0;
 };
+
+// A standard normal draw by Box-Muller, by hand: std::normal_distribution
+// keeps hidden state and its output differs between standard libraries; this
+// is the same everywhere, so a seed makes the same run on any machine.
+inline double standard_normal(std::mt19937_64& rng) noexcept {
+  constexpr double kTwoPi = 6.283185307179586;
+  const double u1 = (static_cast<double>(rng() >> 11) + 0.5) * 0x1.0p-53;
+  const double u2 = static_cast<double>(rng() >> 11) * 0x1.0p-53;
+  return std::sqrt(-2.0 * std::log(u1)) * std::cos(kTwoPi * u2);
+}
 
 class SensorModel {
  public:

@@ -17,14 +17,6 @@ namespace {
   throw std::invalid_argument("fault '" + f.text + "': " + why);
 }
 
-// A standard normal draw, by hand like SensorModel's (same on every library).
-double gaussian(std::mt19937_64& rng) noexcept {
-  constexpr double kTwoPi = 6.283185307179586;
-  const double u1 = (static_cast<double>(rng() >> 11) + 0.5) * 0x1.0p-53;
-  const double u2 = static_cast<double>(rng() >> 11) * 0x1.0p-53;
-  return std::sqrt(-2.0 * std::log(u1)) * std::cos(kTwoPi * u2);
-}
-
 bool is_sensor_fault(FaultKind k) {
   return k == FaultKind::kStuck || k == FaultKind::kRail || k == FaultKind::kNoise || k == FaultKind::kNan ||
          k == FaultKind::kOffset;
@@ -122,7 +114,7 @@ void SimFaults::apply_to_sample(int64_t tick, Sample& s) noexcept {
         v = e.held;
         break;
       case FaultKind::kRail: v = e.rail; break;
-      case FaultKind::kNoise: v += e.spec.value * gaussian(rng_); break;
+      case FaultKind::kNoise: v += e.spec.value * standard_normal(rng_); break;
       case FaultKind::kNan: v = std::numeric_limits<double>::quiet_NaN(); break;
       case FaultKind::kOffset: v += e.spec.value; break;
       default: break;

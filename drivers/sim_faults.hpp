@@ -1,7 +1,7 @@
 // Faults the simulated driver injects into its own rig (issue 7): sensor
 // faults on the converted readings, plant faults through QuarterCarPlant's
 // hooks, and read stalls that make the loop overrun. Given in the KIND@TIME
-// syntax of tools/fault_spec.hpp (`rigctl run --fault`, the config's
+// syntax of drivers/fault_spec.hpp (`rigctl run --fault`, the config's
 // `faults:`), times in rig time. Resolved and checked at construction; the
 // per-tick calls are allocation-, lock- and log-free.
 #pragma once
@@ -15,7 +15,7 @@
 
 #include "drivers/sensor_model.hpp"
 #include "rt/sample.hpp"
-#include "tools/fault_spec.hpp"
+#include "drivers/fault_spec.hpp"
 
 namespace rigctl {
 

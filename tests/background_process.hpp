@@ -8,11 +8,11 @@
 #include <unistd.h>
 
 #include <chrono>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
+
+#include "read_file.hpp"
 
 namespace rigctl::test {
 
@@ -35,12 +35,11 @@ class BackgroundProcess {
   BackgroundProcess(const BackgroundProcess&) = delete;
   BackgroundProcess& operator=(const BackgroundProcess&) = delete;
 
-  std::string output() const {
-    std::ifstream in(output_path_);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-  }
+  std::string output() const { return read_file(output_path_); }
+
+  // The child's pid while it runs (-1 once it has been waited for): for the
+  // test's own signals (kill -9, SIGTERM).
+  pid_t pid() const { return pid_; }
 
   // Waits until the output contains `text`; false after the timeout or when
   // the process ended first.

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "process.hpp"
+#include "read_file.hpp"
 #include "tools/bench_command.hpp"
 #include "tools/bench_json.hpp"
 #include "tools/bench_support.hpp"
@@ -23,12 +24,7 @@ namespace {
 const std::string kRigctl = RIGCTL_BINARY;
 const std::string kConfigDir = std::string(RIGCTL_SOURCE_DIR) + "/config";
 
-std::string read_file(const std::string& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using rigctl::test::read_file;
 
 const Json& member(const Json& j, const std::string& key) {
   const Json* m = j.find(key);

@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "process.hpp"
+#include "read_file.hpp"
 #include "rigctl/command_t.hpp"
 #include "rigctl/controller_t.hpp"
 #include "rigctl/sample_t.hpp"
@@ -41,12 +42,7 @@ class CliTest : public ::testing::Test {
   fs::path dir_;
 };
 
-std::string read_file(const std::string& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using rigctl::test::read_file;
 
 // The log's data messages with their wall-clock utime cleared, re-encoded:
 // what must agree between two runs of the same config and seed.

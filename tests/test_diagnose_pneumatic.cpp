@@ -109,13 +109,6 @@ double param(const diag::CauseResult& c, const std::string& name) {
   return NAN;
 }
 
-double final_param(const diag::Diagnosis& d, const std::string& name) {
-  for (const auto& p : d.final_parameters)
-    if (p.name == name) return p.value;
-  ADD_FAILURE() << "no final parameter " << name;
-  return NAN;
-}
-
 // The effect's size as a departure from its null, fitted and true (see the top).
 struct Sizes {
   double fitted, truth;

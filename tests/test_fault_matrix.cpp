@@ -25,6 +25,7 @@
 
 #include "background_process.hpp"
 #include "process.hpp"
+#include "read_file.hpp"
 #include "rigctl/driver_status_t.hpp"
 #include "rigctl/sample_t.hpp"
 
@@ -41,12 +42,7 @@ constexpr double kPeriod = 0.0025;
 // moves fastest (0.2 m/s), the worst case for a controlled stop.
 constexpr double kFaultAt = 5.0;
 
-std::string read_file(const std::string& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using rigctl::test::read_file;
 
 struct EventLine {
   double t = 0.0;
@@ -111,7 +107,9 @@ void expect_no_gap_before(const LogContents& log, double t_fault, bool rig_time_
   for (std::size_t i = 0; i < log.ticks.size() && log.times[i] < t_fault - 1e-9; ++i) {
     ASSERT_EQ(log.ticks[i], static_cast<int64_t>(i)) << "telemetry tick missing before the fault, at t = " << log.times[i];
     // --fast: rig time is tick x period, so no period was skipped either.
-    if (rig_time_is_ticks) ASSERT_NEAR(log.times[i], static_cast<double>(i) * kPeriod, 1e-9);
+    if (rig_time_is_ticks) {
+      ASSERT_NEAR(log.times[i], static_cast<double>(i) * kPeriod, 1e-9);
+    }
     ++before;
   }
   // In rig time the fault is t_fault/period ticks in; at least that many
@@ -178,7 +176,9 @@ void run_in_process(const FaultMatrix& fx, const InProcessCase& c) {
            e.message.find(suffix) != std::string::npos;
   });
   ASSERT_NE(trip, events.end()) << c.fault << ": no " << c.code << " event " << suffix << "\n" << describe(events);
-  if (!c.channel.empty()) EXPECT_EQ(trip->message.rfind(c.channel + " ", 0), 0u) << trip->message;
+  if (!c.channel.empty()) {
+    EXPECT_EQ(trip->message.rfind(c.channel + " ", 0), 0u) << trip->message;
+  }
   const long detect = std::lround((trip->t - t_fault) / kPeriod);
   EXPECT_GE(detect, 0);
   EXPECT_LE(detect, c.max_detect_periods) << c.fault;
@@ -303,7 +303,9 @@ class WireFaultMatrix : public FaultMatrix {
     if (driver == "modbus_canopen") argv.insert(argv.end(), {"--can-socket", path("valve.sock")});
     BackgroundProcess sim(argv, path("rig-sim.out"));
     ASSERT_TRUE(sim.wait_for("modbus listening on", 10.0)) << sim.output();
-    if (driver == "modbus_canopen") ASSERT_TRUE(sim.wait_for("canopen valve on", 5.0)) << sim.output();
+    if (driver == "modbus_canopen") {
+      ASSERT_TRUE(sim.wait_for("canopen valve on", 5.0)) << sim.output();
+    }
     std::smatch m;
     const std::string started = sim.output();
     ASSERT_TRUE(std::regex_search(started, m, std::regex(R"(modbus listening on 127\.0\.0\.1:(\d+))"))) << started;

@@ -1,6 +1,6 @@
 #include <gtest/gtest.h>
 
-#include "tools/fault_spec.hpp"
+#include "drivers/fault_spec.hpp"
 
 using namespace rigctl;
 
@@ -103,16 +103,10 @@ TEST(FaultSpec, BadSimulatedDriverSpecsNameWhatIsWrong) {
 
 #include "config/config_reader.hpp"
 #include "config/rig_config.hpp"
+#include "config_edit.hpp"
 #include "process.hpp"
 
-namespace {
-std::string shipped_config() {
-  std::ifstream in(std::string(RIGCTL_SOURCE_DIR) + "/config/quarter_car.yaml");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-}  // namespace
+using rigctl::test::shipped_config;
 
 TEST(FaultSpec, ConfigFaultsListIsReadAndABadEntryIsNamed) {
   const RigConfig c = parse_rig_config(shipped_config() + "\nfaults: [\"stuck@5:x_r\", \"burst@6:p2\"]\n", "q.yaml");

@@ -14,6 +14,8 @@
 #include "config/config_reader.hpp"
 #include "config/rig_config.hpp"
 #include "process.hpp"
+#include "config_edit.hpp"
+#include "read_file.hpp"
 #include "rt/fuzzy_engine.hpp"
 #include "rt/setpoint_profile.hpp"
 #include "tools/rig_assembly.hpp"
@@ -27,12 +29,7 @@ namespace {
 const std::string kRigctl = RIGCTL_BINARY;
 const std::string kConfig = std::string(RIGCTL_SOURCE_DIR) + "/config/half_car.yaml";
 
-std::string read_file(const std::string& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using rigctl::test::read_file;
 
 class HalfCarRig : public ::testing::Test {
  protected:
@@ -66,29 +63,8 @@ std::pair<std::vector<std::string>, int> csv_shape(const std::string& p) {
 
 bool has(const std::vector<std::string>& v, const std::string& x) { return std::find(v.begin(), v.end(), x) != v.end(); }
 
-// Replaces the first line matching `pattern` (regex over one line).
-std::string edit(const std::string& text, const std::string& pattern, const std::string& replacement) {
-  const std::regex re(pattern);
-  std::string out = std::regex_replace(text, re, replacement, std::regex_constants::format_first_only);
-  EXPECT_NE(out, text) << "pattern not found: " << pattern;
-  return out;
-}
-
-std::string error_of(const std::string& yaml) {
-  try {
-    const auto config = parse_rig_config(yaml, "bad.yaml");
-    assemble_rig(config);
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return "";
-}
-
-void expect_error(const std::string& yaml, const std::vector<std::string>& fragments) {
-  const std::string e = error_of(yaml);
-  ASSERT_FALSE(e.empty()) << "config was accepted";
-  for (const auto& f : fragments) EXPECT_NE(e.find(f), std::string::npos) << "'" << f << "' not in: " << e;
-}
+using test::edit;
+using test::expect_config_error;
 
 }  // namespace
 
@@ -328,43 +304,43 @@ TEST(HalfCarConfig, HoldProfileIsAConstant) {
 
 TEST(HalfCarConfig, BadKeysGiveClearErrorsNamingTheKey) {
   const std::string shipped = read_file(kConfig);
-  expect_error(edit(shipped, "    spring_n_per_m: 80000.0 ", "    spring_rate: 80000.0\n    spring_n_per_m: 80000.0 "),
+  expect_config_error(edit(shipped, "    spring_n_per_m: 80000.0 ", "    spring_rate: 80000.0\n    spring_n_per_m: 80000.0 "),
                {"bad.yaml:", "plant.corner_1.spring_rate", "unknown key"});
-  expect_error(edit(shipped, "    spring_n_per_m: 80000.0 ", "    spring_rate: 80000.0 "),
+  expect_config_error(edit(shipped, "    spring_n_per_m: 80000.0 ", "    spring_rate: 80000.0 "),
                {"bad.yaml:", "plant.corner_1.spring_n_per_m", "missing required key"});
-  expect_error(edit(shipped, "    damper_n_s_per_m: 1500.0 # Table 2 C1[^\n]*\n", ""),
+  expect_config_error(edit(shipped, "    damper_n_s_per_m: 1500.0 # Table 2 C1[^\n]*\n", ""),
                {"bad.yaml:", "plant.corner_1.damper_n_s_per_m", "missing required key"});
-  expect_error(edit(shipped, "  plane: pitch ", "  plane: yaw "), {"plant.plane", "unknown value 'yaw'", "pitch, roll"});
-  expect_error(edit(shipped, "    kind: bump ", "    kind: cobbles "), {"plant.road.kind", "unknown value 'cobbles'"});
-  expect_error(edit(shipped, "      class: C ", "      class: F "), {"plant.road.iso8608.class", "'F'"});
-  expect_error(edit(shipped, "      amplitude_m: 0.05 ", "      amplitude_m: -0.05 "),
+  expect_config_error(edit(shipped, "  plane: pitch ", "  plane: yaw "), {"plant.plane", "unknown value 'yaw'", "pitch, roll"});
+  expect_config_error(edit(shipped, "    kind: bump ", "    kind: cobbles "), {"plant.road.kind", "unknown value 'cobbles'"});
+  expect_config_error(edit(shipped, "      class: C ", "      class: F "), {"plant.road.iso8608.class", "'F'"});
+  expect_config_error(edit(shipped, "      amplitude_m: 0.05 ", "      amplitude_m: -0.05 "),
                {"plant.road.bump.amplitude_m", "got -0.05"});
-  expect_error(edit(shipped, "  vehicle_speed_m_s: 20.0 ", "  vehicle_speed_m_s: fast "),
+  expect_config_error(edit(shipped, "  vehicle_speed_m_s: 20.0 ", "  vehicle_speed_m_s: fast "),
                {"plant.vehicle_speed_m_s", "expected a number", "'fast'"});
-  expect_error(edit(shipped, "  type: fuzzy ", "  type: pid "), {"controller.type", "unknown value 'pid'", "skyhook"});
-  expect_error(edit(shipped, "  force_limit_n: 2000.0", "  force_limit_n: 8000.0"),
+  expect_config_error(edit(shipped, "  type: fuzzy ", "  type: pid "), {"controller.type", "unknown value 'pid'", "skyhook"});
+  expect_config_error(edit(shipped, "  force_limit_n: 2000.0", "  force_limit_n: 8000.0"),
                {"controller.force_limit_n", "outputs.f_1.range"});
-  expect_error(edit(shipped, "  output_2: f_2 ", "  output_2: f_9 "), {"controller.output_2", "unknown output channel 'f_9'"});
-  expect_error(edit(shipped, "      NS: \"NM NS NS\"", "      NS: \"NM NS NX\""),
+  expect_config_error(edit(shipped, "  output_2: f_2 ", "  output_2: f_9 "), {"controller.output_2", "unknown output channel 'f_9'"});
+  expect_config_error(edit(shipped, "      NS: \"NM NS NS\"", "      NS: \"NM NS NX\""),
                {"controller.fuzzy.rules.NS", "unknown output set 'NX'"});
-  expect_error(edit(shipped, "      NS: \"NM NS NS\"", "      NS: \"NM NS\""), {"controller.fuzzy.rules.NS", "expected 3"});
-  expect_error(edit(shipped, "      NS: \"NM NS NS\"\n", ""), {"controller.fuzzy.rules.NS", "missing required key"});
-  expect_error(edit(shipped, "          NL: \\{triangle: \\[-0.8, -0.6, -0.4\\]\\}", "          NL: {triangle: [-0.4, -0.6, -0.8]}"),
+  expect_config_error(edit(shipped, "      NS: \"NM NS NS\"", "      NS: \"NM NS\""), {"controller.fuzzy.rules.NS", "expected 3"});
+  expect_config_error(edit(shipped, "      NS: \"NM NS NS\"\n", ""), {"controller.fuzzy.rules.NS", "missing required key"});
+  expect_config_error(edit(shipped, "          NL: \\{triangle: \\[-0.8, -0.6, -0.4\\]\\}", "          NL: {triangle: [-0.4, -0.6, -0.8]}"),
                {"controller.fuzzy.inputs.velocity_error.sets.NL.triangle"});
-  expect_error(edit(shipped, "          NL: \\{triangle: \\[-0.8, -0.6, -0.4\\]\\}", "          NL: {triangle: [-0.8, -0.6]}"),
+  expect_config_error(edit(shipped, "          NL: \\{triangle: \\[-0.8, -0.6, -0.4\\]\\}", "          NL: {triangle: [-0.8, -0.6]}"),
                {"controller.fuzzy.inputs.velocity_error.sets.NL.triangle", "expected 3 numbers"});
-  expect_error(edit(shipped, "          NL: \\{triangle: \\[-0.8, -0.6, -0.4\\]\\}", "          NL: {bell: [-0.8, -0.6, -0.4]}"),
+  expect_config_error(edit(shipped, "          NL: \\{triangle: \\[-0.8, -0.6, -0.4\\]\\}", "          NL: {bell: [-0.8, -0.6, -0.4]}"),
                {"controller.fuzzy.inputs.velocity_error.sets.NL", "exactly one shape"});
-  expect_error(edit(shipped, "    c_sky_n_s_per_m: 4000.0", "    c_sky_n_s_per_m: 4000.0\n    c_sky: 4000.0"),
+  expect_config_error(edit(shipped, "    c_sky_n_s_per_m: 4000.0", "    c_sky_n_s_per_m: 4000.0\n    c_sky: 4000.0"),
                {"controller.skyhook.c_sky", "unknown key"});
-  expect_error(edit(shipped, "    angle_rad: 0.03", "    angle_rad: 0"), {"controller.lqr.angle_rad"});
-  expect_error(edit(shipped, "  duration_s: 10.0 ", "  length_s: 10.0 "), {"profile.duration_s", "missing required key"});
-  expect_error(edit(shipped, "    spring_1: \\[75000.0, 100000.0\\]", "    mass_body: [500.0, 1500.0]"),
+  expect_config_error(edit(shipped, "    angle_rad: 0.03", "    angle_rad: 0"), {"controller.lqr.angle_rad"});
+  expect_config_error(edit(shipped, "  duration_s: 10.0 ", "  length_s: 10.0 "), {"profile.duration_s", "missing required key"});
+  expect_config_error(edit(shipped, "    spring_1: \\[75000.0, 100000.0\\]", "    mass_body: [500.0, 1500.0]"),
                {"optimize.variables.mass_body", "unknown design variable"});
-  expect_error(edit(shipped, "  algorithm: crs2_lm ", "  algorithm: genetic "), {"optimize.algorithm", "isres"});
-  expect_error(edit(shipped, "  settling_band_percent: 5.0", "  settling_band_percent: 150"),
+  expect_config_error(edit(shipped, "  algorithm: crs2_lm ", "  algorithm: genetic "), {"optimize.algorithm", "isres"});
+  expect_config_error(edit(shipped, "  settling_band_percent: 5.0", "  settling_band_percent: 150"),
                {"report.settling_band_percent", "got 150"});
-  expect_error(edit(shipped, "  z_s_ddot: \\{", "  z_s_dddot: {"), {"sensors.z_s_dddot"});
+  expect_config_error(edit(shipped, "  z_s_ddot: \\{", "  z_s_dddot: {"), {"sensors.z_s_dddot"});
 }
 
 TEST_F(HalfCarRig, BadConfigStopsTheProgramsWithExitCode2) {

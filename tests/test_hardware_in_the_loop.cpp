@@ -16,6 +16,7 @@
 
 #include "background_process.hpp"
 #include "process.hpp"
+#include "read_file.hpp"
 
 using rigctl::test::BackgroundProcess;
 using rigctl::test::run_command;
@@ -28,12 +29,7 @@ const std::string kConfig = std::string(RIGCTL_SOURCE_DIR) + "/config/quarter_ca
 constexpr double kPeriod = 0.0025;
 constexpr double kMaxAge = 0.1;
 
-std::string read_file(const std::string& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using rigctl::test::read_file;
 
 struct RunFile {
   std::vector<std::string> names;

@@ -24,6 +24,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "rigctl/sample_t.hpp"
+#include "test_netns.hpp"
 #include "rt/telemetry_publisher.hpp"
 
 namespace fs = std::filesystem;
@@ -56,15 +57,6 @@ pid_t spawn(const std::vector<std::string>& args, bool quiet = false) {
   return pid;
 }
 
-// Runs argv to completion; returns its exit status (127: could not exec).
-int run(const std::vector<std::string>& args) {
-  const pid_t pid = spawn(args, true);
-  if (pid < 0) return -1;
-  int status = 0;
-  if (::waitpid(pid, &status, 0) != pid) return -1;
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
 bool on_path(const std::string& name) {
   const char* path = std::getenv("PATH");
   std::string dirs = path != nullptr ? path : "/usr/bin:/bin";
@@ -75,12 +67,6 @@ bool on_path(const std::string& name) {
     start = end + 1;
   }
   return false;
-}
-
-std::string join(const std::vector<std::string>& args) {
-  std::string s;
-  for (const auto& a : args) s += (s.empty() ? "" : " ") + a;
-  return s;
 }
 
 TelemetryMeta meta() {
@@ -124,21 +110,8 @@ std::map<int64_t, std::vector<uint8_t>> samples_in(const std::string& path, cons
 class LcmUdpmTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    if (::geteuid() != 0) GTEST_SKIP() << "needs root to create a network namespace";
-    if (!on_path("ip")) GTEST_SKIP() << "no 'ip' program (iproute2) on PATH";
+    if (!ns_.ready()) GTEST_SKIP() << ns_.skip_reason();
     if (!on_path("lcm-logger")) GTEST_SKIP() << "lcm-logger not installed (liblcm-bin)";
-    ns_ = "rigctl-test-" + std::to_string(::getpid());
-    const std::vector<std::vector<std::string>> steps = {
-        {"ip", "netns", "add", ns_},
-        {"ip", "netns", "exec", ns_, "ip", "link", "set", "lo", "up"},
-        {"ip", "netns", "exec", ns_, "ip", "link", "set", "lo", "multicast", "on"},
-        {"ip", "netns", "exec", ns_, "ip", "route", "add", "224.0.0.0/4", "dev", "lo"},
-    };
-    for (const auto& step : steps) {
-      const int rc = run(step);
-      if (rc != 0) GTEST_SKIP() << "cannot set up a test network namespace: '" << join(step) << "' exited " << rc;
-      if (step[2] == "add") ns_created_ = true;
-    }
     dir_ = fs::temp_directory_path() / ("rigctl_test_udpm_" + std::to_string(::getpid()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
@@ -146,7 +119,6 @@ class LcmUdpmTest : public ::testing::Test {
 
   void TearDown() override {
     stop_logger();
-    if (ns_created_ && run({"ip", "netns", "del", ns_}) != 0) ADD_FAILURE() << "could not delete netns " << ns_;
     if (!dir_.empty()) fs::remove_all(dir_);
   }
 
@@ -170,8 +142,7 @@ class LcmUdpmTest : public ::testing::Test {
 
   bool logger_alive() { return logger_pid_ > 0 && ::waitpid(logger_pid_, nullptr, WNOHANG) == 0; }
 
-  std::string ns_;
-  bool ns_created_ = false;
+  test::TestNetns ns_{"udpm"};
   fs::path dir_;
   pid_t logger_pid_ = -1;
 };
@@ -179,20 +150,9 @@ class LcmUdpmTest : public ::testing::Test {
 // Runs in its own thread, which has joined the test namespace first: setns
 // changes only the calling thread, so the LCM sockets made here (and by the
 // publisher thread it starts) live in the namespace. Returns "" or an error.
-std::string publish_in_namespace(const std::string& ns, const std::string& pub_log, const std::string& logger_log,
+std::string publish_in_namespace(const test::TestNetns& ns, const std::string& pub_log, const std::string& logger_log,
                                  const std::function<bool()>& logger_alive) {
-  const std::string ns_file = "/var/run/netns/" + ns;
-  const int fd = ::open(ns_file.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return "open " + ns_file + ": " + std::strerror(errno);
-  const int rc = ::setns(fd, CLONE_NEWNET);
-  ::close(fd);
-  if (rc != 0) return std::string("setns: ") + std::strerror(errno);
-  // Make sure before any multicast: this thread's network namespace is the test's.
-  struct stat want{}, have{};
-  if (::stat(ns_file.c_str(), &want) != 0 || ::stat("/proc/thread-self/ns/net", &have) != 0 ||
-      want.st_ino != have.st_ino) {
-    return "thread is not in network namespace " + ns + ": refusing to use multicast";
-  }
+  if (const std::string error = ns.enter_this_thread(); !error.empty()) return error;
 
   TelemetryPublisher pub(meta(), kUrl, pub_log);
   // Ready check: probe until the logger has received and flushed something.
@@ -221,7 +181,7 @@ std::string publish_in_namespace(const std::string& ns, const std::string& pub_l
 TEST_F(LcmUdpmTest, LoggerInAnotherProcessReceivesPublishedSamples) {
   const std::string logger_log = (dir_ / "logger.lcm").string();
   const std::string pub_log = (dir_ / "publisher.lcm").string();
-  logger_pid_ = spawn({"ip", "netns", "exec", ns_, "lcm-logger", "--quiet", std::string("--lcm-url=") + kUrl, logger_log});
+  logger_pid_ = spawn({"ip", "netns", "exec", ns_.name(), "lcm-logger", "--quiet", std::string("--lcm-url=") + kUrl, logger_log});
   ASSERT_GT(logger_pid_, 0) << "fork failed";
 
   std::string error = "thread did not run";

@@ -28,6 +28,7 @@
 
 #include "rigctl/state_t.hpp"
 #include "tests/process.hpp"
+#include "tests/test_netns.hpp"
 #include "tools/cmd_command.hpp"
 #include "tools/command_receiver.hpp"
 #include "tools/operator_auth.hpp"
@@ -504,18 +505,6 @@ TEST(RigctlCmd, RefusesBadKeyFilesAndUsageBeforeSendingAnything) {
 
 constexpr const char* kUrl = "udpm://239.255.76.67:7667?ttl=0";
 
-bool on_path(const std::string& name) {
-  const char* path = std::getenv("PATH");
-  std::string dirs = path != nullptr ? path : "/usr/bin:/bin";
-  std::size_t start = 0;
-  while (start <= dirs.size()) {
-    const std::size_t end = std::min(dirs.find(':', start), dirs.size());
-    if (::access((dirs.substr(start, end - start) + "/" + name).c_str(), X_OK) == 0) return true;
-    start = end + 1;
-  }
-  return false;
-}
-
 // Receives acks on the test's side (for the raw replays below).
 struct AckLog {
   std::vector<operator_ack_t> acks;
@@ -528,42 +517,16 @@ struct AckLog {
 class OperatorCommandsUdpm : public ::testing::Test {
  protected:
   void SetUp() override {
-    if (::geteuid() != 0) GTEST_SKIP() << "needs root to create a network namespace";
-    if (!on_path("ip")) GTEST_SKIP() << "no 'ip' program (iproute2) on PATH";
-    ns_ = "rigctl-opcmd-" + std::to_string(::getpid());
-    for (const std::string& step : {"ip netns add " + ns_, "ip netns exec " + ns_ + " ip link set lo up",
-                                    "ip netns exec " + ns_ + " ip link set lo multicast on",
-                                    "ip netns exec " + ns_ + " ip route add 224.0.0.0/4 dev lo"}) {
-      const auto r = test::run_command(step);
-      if (r.exit_code != 0) GTEST_SKIP() << "cannot set up a test network namespace: '" << step << "' exited " << r.exit_code << ": " << r.output;
-      if (step.rfind("ip netns add", 0) == 0) ns_created_ = true;
-    }
-  }
-  void TearDown() override {
-    if (ns_created_ && test::run_command("ip netns del " + ns_).exit_code != 0) ADD_FAILURE() << "could not delete netns " << ns_;
+    if (!ns_.ready()) GTEST_SKIP() << ns_.skip_reason();
   }
 
-  // Moves the calling thread into the namespace and makes sure of it.
-  std::string enter_namespace() const {
-    const std::string ns_file = "/var/run/netns/" + ns_;
-    const int fd = ::open(ns_file.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd < 0) return "open " + ns_file + ": " + std::strerror(errno);
-    const int rc = ::setns(fd, CLONE_NEWNET);
-    ::close(fd);
-    if (rc != 0) return std::string("setns: ") + std::strerror(errno);
-    struct stat want{}, have{};
-    if (::stat(ns_file.c_str(), &want) != 0 || ::stat("/proc/thread-self/ns/net", &have) != 0 || want.st_ino != have.st_ino) {
-      return "thread is not in network namespace " + ns_ + ": refusing to use multicast";
-    }
-    return "";
-  }
+  std::string enter_namespace() const { return ns_.enter_this_thread(); }
 
   test::ProcessResult rigctl_cmd(const std::string& args) const {
-    return test::run_command("ip netns exec " + ns_ + " " + binary() + " cmd " + args + " --lcm-url '" + kUrl + "'");
+    return test::run_command(ns_.exec_prefix() + binary() + " cmd " + args + " --lcm-url '" + kUrl + "'");
   }
 
-  std::string ns_;
-  bool ns_created_ = false;
+  test::TestNetns ns_{"opcmd"};
 };
 
 // Pops whatever the receiver queued within `timeout`.

@@ -20,6 +20,8 @@
 #include "config/config_reader.hpp"
 #include "config/rig_config.hpp"
 #include "process.hpp"
+#include "read_file.hpp"
+#include "test_netns.hpp"
 
 namespace fs = std::filesystem;
 using rigctl::test::BackgroundProcess;
@@ -31,12 +33,7 @@ const std::string kRigctl = RIGCTL_BINARY;
 const std::string kConfig = std::string(RIGCTL_SOURCE_DIR) + "/config/quarter_car.yaml";
 const std::string kUrl = "udpm://239.255.76.67:7667?ttl=0";
 
-std::string read_file(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using rigctl::test::read_file;
 
 void write_key(const fs::path& p, char fill) {
   std::ofstream(p) << std::string(32, fill);
@@ -58,16 +55,7 @@ std::vector<std::string> state_changes(const std::string& events) {
 class OperatorMode : public ::testing::Test {
  protected:
   void SetUp() override {
-    if (::geteuid() != 0) GTEST_SKIP() << "needs root to create a network namespace";
-    if (run_command("ip -V").exit_code != 0) GTEST_SKIP() << "no 'ip' program (iproute2) on PATH";
-    ns_ = "rigctl-opmode-" + std::to_string(::getpid());
-    for (const std::string& step : {"ip netns add " + ns_, "ip netns exec " + ns_ + " ip link set lo up",
-                                    "ip netns exec " + ns_ + " ip link set lo multicast on",
-                                    "ip netns exec " + ns_ + " ip route add 224.0.0.0/4 dev lo"}) {
-      const auto r = run_command(step);
-      if (r.exit_code != 0) GTEST_SKIP() << "cannot set up a network namespace: '" << step << "': " << r.output;
-      if (step.rfind("ip netns add", 0) == 0) ns_created_ = true;
-    }
+    if (!ns_.ready()) GTEST_SKIP() << ns_.skip_reason();
     dir_ = fs::temp_directory_path() / ("rigctl_opmode_" + std::to_string(::getpid()));
     fs::create_directories(dir_);
     key_ = (dir_ / "rig.key").string();
@@ -78,10 +66,9 @@ class OperatorMode : public ::testing::Test {
   }
   void TearDown() override {
     if (!dir_.empty()) fs::remove_all(dir_);
-    if (ns_created_ && run_command("ip netns del " + ns_).exit_code != 0) ADD_FAILURE() << "could not delete netns " << ns_;
   }
 
-  std::string in_ns(const std::string& command) const { return "ip netns exec " + ns_ + " " + command; }
+  std::string in_ns(const std::string& command) const { return ns_.exec_prefix() + command; }
 
   rigctl::test::ProcessResult cmd(const std::string& command, const std::string& key) const {
     return run_command(in_ns(kRigctl + " cmd " + command + " --key " + key + " --lcm-url '" + kUrl +
@@ -98,8 +85,7 @@ class OperatorMode : public ::testing::Test {
     return false;
   }
 
-  std::string ns_;
-  bool ns_created_ = false;
+  rigctl::test::TestNetns ns_{"opmode"};
   fs::path dir_, events_;
   std::string key_, wrong_key_;
 };

@@ -2,47 +2,17 @@
 // naming the file, the key and the reason.
 #include <gtest/gtest.h>
 
-#include <fstream>
-#include <regex>
-#include <sstream>
-
 #include "config/config_reader.hpp"
 #include "config/rig_config.hpp"
+#include "config_edit.hpp"
 #include "tools/rig_assembly.hpp"
 
 using namespace rigctl;
 
 namespace {
-std::string shipped_config() {
-  std::ifstream in(std::string(RIGCTL_SOURCE_DIR) + "/config/quarter_car.yaml");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-// Replaces the first line matching `pattern` (regex over one line).
-std::string edit(const std::string& text, const std::string& pattern, const std::string& replacement) {
-  const std::regex re(pattern);
-  std::string out = std::regex_replace(text, re, replacement, std::regex_constants::format_first_only);
-  EXPECT_NE(out, text) << "pattern not found: " << pattern;
-  return out;
-}
-
-std::string error_of(const std::string& yaml) {
-  try {
-    const auto config = parse_rig_config(yaml, "bad.yaml");
-    assemble_rig(config);
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return "";
-}
-
-void expect_error(const std::string& yaml, const std::vector<std::string>& fragments) {
-  const std::string e = error_of(yaml);
-  ASSERT_FALSE(e.empty()) << "config was accepted";
-  for (const auto& f : fragments) EXPECT_NE(e.find(f), std::string::npos) << "'" << f << "' not in: " << e;
-}
+using test::edit;
+using test::expect_config_error;
+using test::shipped_config;
 }  // namespace
 
 TEST(RigConfig, ShippedConfigLoadsWithThePapersModel) {
@@ -58,30 +28,30 @@ TEST(RigConfig, ShippedConfigLoadsWithThePapersModel) {
 }
 
 TEST(RigConfig, UnknownKey) {
-  expect_error(edit(shipped_config(), "  kp: 80.0", "  kp: 80.0\n  kd: 1.0"),
+  expect_config_error(edit(shipped_config(), "  kp: 80.0", "  kp: 80.0\n  kd: 1.0"),
                {"bad.yaml:", "controller.kd", "unknown key"});
 }
 
 TEST(RigConfig, MissingKey) {
-  expect_error(edit(shipped_config(), "  ki: 60.0[^\n]*\n", ""), {"bad.yaml:", "controller.ki", "missing required key"});
+  expect_config_error(edit(shipped_config(), "  ki: 60.0[^\n]*\n", ""), {"bad.yaml:", "controller.ki", "missing required key"});
 }
 
 TEST(RigConfig, WrongType) {
-  expect_error(edit(shipped_config(), "  period_s: 0.0025", "  period_s: fast"),
+  expect_config_error(edit(shipped_config(), "  period_s: 0.0025", "  period_s: fast"),
                {"bad.yaml:", "loop.period_s", "expected a number", "'fast'"});
-  expect_error(edit(shipped_config(), "    leakage: true", "    leakage: maybe"),
+  expect_config_error(edit(shipped_config(), "    leakage: true", "    leakage: maybe"),
                {"plant.hydraulics.leakage", "expected true or false"});
 }
 
 TEST(RigConfig, OutOfRange) {
-  expect_error(edit(shipped_config(), "  period_s: 0.0025", "  period_s: 5"),
+  expect_config_error(edit(shipped_config(), "  period_s: 0.0025", "  period_s: 5"),
                {"bad.yaml:", "loop.period_s", "must be in [0.0001, 0.1]", "got 5"});
-  expect_error(edit(shipped_config(), "    construction_angle_deg: 62.0", "    construction_angle_deg: 95"),
+  expect_config_error(edit(shipped_config(), "    construction_angle_deg: 62.0", "    construction_angle_deg: 95"),
                {"plant.bearing_friction.construction_angle_deg", "got 95"});
 }
 
 TEST(RigConfig, UnknownRigKind) {
-  expect_error(edit(shipped_config(), "rig: quarter_car", "rig: quarter_cat"),
+  expect_config_error(edit(shipped_config(), "rig: quarter_car", "rig: quarter_cat"),
                {"bad.yaml:", "rig", "unknown value 'quarter_cat'", "quarter_car"});
 }
 
@@ -94,18 +64,18 @@ TEST(RigConfig, LineNumberPointsAtTheBadValue) {
     ++n;
     if (line.find("period_s: -1") != std::string::npos) bad_line = n;
   }
-  expect_error(yaml, {"bad.yaml:" + std::to_string(bad_line) + ":"});
+  expect_config_error(yaml, {"bad.yaml:" + std::to_string(bad_line) + ":"});
 }
 
 TEST(RigConfig, UnknownChannelNames) {
-  expect_error(edit(shipped_config(), "  feedback: x_r", "  feedback: x_q"),
+  expect_config_error(edit(shipped_config(), "  feedback: x_r", "  feedback: x_q"),
                {"controller.feedback", "unknown input channel 'x_q'", "x_r"});
-  expect_error(edit(shipped_config(), "  x_r: \\[-0.012, 0.172\\]", "  x_z: [-0.012, 0.172]"), {"limits.x_z"});
-  expect_error(edit(shipped_config(), "  f_t: \\{", "  f_z: {"), {"sensors.f_z"});
+  expect_config_error(edit(shipped_config(), "  x_r: \\[-0.012, 0.172\\]", "  x_z: [-0.012, 0.172]"), {"limits.x_z"});
+  expect_config_error(edit(shipped_config(), "  f_t: \\{", "  f_z: {"), {"sensors.f_z"});
 }
 
 TEST(RigConfig, SyntaxErrorNamesTheLine) {
-  expect_error(edit(shipped_config(), "  kp: 80.0", "  kp: [80.0"), {"bad.yaml:", "YAML syntax error"});
+  expect_config_error(edit(shipped_config(), "  kp: 80.0", "  kp: [80.0"), {"bad.yaml:", "YAML syntax error"});
 }
 
 TEST(RigConfig, MissingFile) {
@@ -118,7 +88,9 @@ TEST(RigConfig, MissingFile) {
 }
 
 TEST(RigConfig, CasesMergeOverTheFileAndUnknownCasesAreNamed) {
-  const std::string yaml = shipped_config() + R"(
+  // The shipped cases replaced by the test's own.
+  const std::string shipped = shipped_config();
+  const std::string yaml = shipped.substr(0, shipped.find("\ncases:")) + R"(
 cases:
   soft: {controller: {kp: 40.0}, plant: {bearing_friction: {enabled: false}}}
   broken: {controller: {kq: 1.0}}
@@ -160,3 +132,20 @@ TEST(RigConfig, PneumaticConfigAndEveryPaperCaseLoad) {
   const auto fig4e = load_rig_config(path, "fig4e");
   EXPECT_DOUBLE_EQ(fig4e.pneumatic_rotary.inertia, 0.4);
 }
+
+namespace rigctl {
+namespace {
+
+// The quarter car's `diagnosis` case turns the ramp_steps profile into a
+// demand table: a case that changes a section's type replaces the section
+// (merged key by key, the ramp keys would be unknown to a csv profile).
+TEST(RigConfigCases, ACaseThatChangesASectionsTypeReplacesTheSection) {
+  const RigConfig c = load_rig_config(RIGCTL_SOURCE_DIR "/config/quarter_car.yaml", "diagnosis");
+  EXPECT_EQ(c.profile.type, "csv");
+  EXPECT_NE(c.profile.csv_file.find("quarter_car_diagnosis_demand.csv"), std::string::npos) << c.profile.csv_file;
+  EXPECT_EQ(c.profile.csv_column, "x_ref");
+  EXPECT_TRUE(c.profile.steps.empty());
+}
+
+}  // namespace
+}  // namespace rigctl

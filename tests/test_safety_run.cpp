@@ -19,11 +19,14 @@
 
 #include <fcntl.h>
 
+#include "background_process.hpp"
 #include "process.hpp"
+#include "read_file.hpp"
 #include "rigctl/sample_t.hpp"
 #include "rigctl/state_t.hpp"
 #include "tools/log2csv.hpp"
 
+using rigctl::test::BackgroundProcess;
 using rigctl::test::run_command;
 namespace fs = std::filesystem;
 
@@ -32,12 +35,7 @@ namespace {
 const std::string kRigctl = RIGCTL_BINARY;
 const std::string kConfig = std::string(RIGCTL_SOURCE_DIR) + "/config/quarter_car.yaml";
 
-std::string read_file(const std::string& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using rigctl::test::read_file;
 
 std::vector<std::string> lines_of(const std::string& text) {
   std::vector<std::string> out;
@@ -77,54 +75,6 @@ LogContents read_lcm_log(const std::string& path) {
   return c;
 }
 
-// `rigctl run` in the background, its output in a file; signalled by pid.
-class RunProcess {
- public:
-  RunProcess(const std::vector<std::string>& argv, std::string output_path) : output_path_(std::move(output_path)) {
-    pid_ = fork();
-    if (pid_ == 0) {
-      const int fd = ::open(output_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      dup2(fd, 1);
-      dup2(fd, 2);
-      std::vector<char*> args;
-      for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-      args.push_back(nullptr);
-      execv(args[0], args.data());
-      _exit(127);
-    }
-  }
-  ~RunProcess() {
-    if (pid_ > 0) {
-      ::kill(pid_, SIGKILL);
-      wait();
-    }
-  }
-  pid_t pid() const { return pid_; }
-  std::string output() const { return read_file(output_path_); }
-  bool wait_for(const std::string& text, double timeout_s) {
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-    while (std::chrono::steady_clock::now() < deadline) {
-      if (output().find(text) != std::string::npos) return true;
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
-    return output().find(text) != std::string::npos;
-  }
-  // Exit code, or -1 when a signal ended it.
-  int wait() {
-    if (pid_ <= 0) return status_;
-    int st = 0;
-    waitpid(pid_, &st, 0);
-    pid_ = -1;
-    status_ = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-    return status_;
-  }
-
- private:
-  pid_t pid_ = -1;
-  int status_ = -1;
-  std::string output_path_;
-};
-
 class SafetyRun : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -150,8 +100,8 @@ class SafetyRun : public ::testing::Test {
     return p;
   }
 
-  std::unique_ptr<RunProcess> start_run(const std::string& config, double duration = 30.0) {
-    return std::make_unique<RunProcess>(
+  std::unique_ptr<BackgroundProcess> start_run(const std::string& config, double duration = 30.0) {
+    return std::make_unique<BackgroundProcess>(
         std::vector<std::string>{kRigctl, "run", config, "--duration", std::to_string(duration), "--log", path("run.lcm"),
                                  "--no-realtime"},
         path("out.txt"));

@@ -13,18 +13,14 @@
 #include <sstream>
 
 #include "process.hpp"
+#include "read_file.hpp"
 
 namespace fs = std::filesystem;
 using rigctl::test::run_command;
 
 namespace {
 
-std::string read_file(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using rigctl::test::read_file;
 
 class InstalledTree : public ::testing::Test {
  protected:

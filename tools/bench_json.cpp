@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "tools/json_text.hpp"
+
 namespace rigctl {
 
 Json& Json::operator[](const std::string& key) {
@@ -32,27 +34,8 @@ void Json::push_back(Json value) {
 
 namespace {
 
-void escape_to(std::string& out, const std::string& s) {
-  out += '"';
-  for (const char c : s) {
-    switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\t': out += "\\t"; break;
-      case '\r': out += "\\r"; break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(static_cast<unsigned char>(c)));
-          out += buf;
-        } else {
-          out += c;
-        }
-    }
-  }
-  out += '"';
-}
+// One string formatter for every JSON the program writes (tools/json_text).
+void escape_to(std::string& out, const std::string& s) { out += json_string(s); }
 
 void newline(std::string& out, int indent, int depth) {
   if (indent < 0) return;

@@ -8,7 +8,7 @@
 # -oom-, -leak-) and the command to reproduce it is printed.
 #   tools/fuzz.sh [SECONDS_PER_TARGET] [TARGET...]
 #     SECONDS_PER_TARGET  default 20; 0 only builds and replays the corpora
-#     TARGET              config run_file modbus canopen operator_command (default: all built)
+#     TARGET              config run_file modbus canopen operator_command (default: all)
 #   FUZZ_JOBS=N  fuzzers run N at a time (default: the number of CPUs)
 # New inputs go to build-fuzz/work/<target>/ (kept between local runs, never
 # into the committed corpus). Installs clang and its fuzzer/sanitizer runtime
@@ -20,19 +20,7 @@ shift || true
 build="$root/build-fuzz"
 
 packages=(cmake make clang libclang-rt-14-dev libyaml-cpp-dev libeigen3-dev liblcm-dev liblcm-bin libglib2.0-dev libssl-dev)
-missing=()
-for p in "${packages[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-  echo "fuzz: installing ${missing[*]}"
-  if [ "$(id -u)" -ne 0 ]; then
-    echo "fuzz: these Debian packages are missing and installing them needs root: ${missing[*]}" >&2
-    exit 1
-  fi
-  apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}"
-fi
+"$root/tools/install_packages.sh" fuzz "${packages[@]}"
 
 start=$(date +%s)
 CXX=clang++ cmake -S "$root/tests/fuzz" -B "$build" >/dev/null

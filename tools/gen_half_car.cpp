@@ -30,10 +30,6 @@ void make_clean(RigConfig& c) {
   p.actuator_time_constant = 0.0;
   p.actuator_valve_time_constant = 0.0;
   p.actuator_force_limit = 0.0;  // the controller clamps; a plant saturation would be an unmodelled effect
-  for (auto& [name, s] : c.sensors) {
-    s.offset = 0.0;
-    s.delay_s = 0.0;
-  }
   // The road is the case's: its humps are sized so that both tyres keep
   // contact (config/half_car.yaml, case `diagnosis`). Lift-off is not switched
   // off here because it is not a switch: it is what a harsher road does.

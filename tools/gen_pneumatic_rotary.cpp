@@ -51,10 +51,6 @@ void make_clean(RigConfig& c) {
   p.heat_capacity_ratio = 1.4;  // adiabatic, the seed's and the diagnosis baseline's
   p.valve_null_offset = 0.0;
   p.valve_overlap = 0.0;
-  for (const char* s : {"theta", "dp", "omega"}) {
-    c.sensors[s].delay_s = 0.0;
-    c.sensors[s].offset = 0.0;
-  }
 }
 
 AppliedEffect apply(RigConfig& c, const std::string& cause, double level) {

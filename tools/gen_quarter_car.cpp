@@ -13,24 +13,9 @@ namespace rigctl {
 
 namespace {
 
-// The diagnosis excitation (tools/excitation/quarter_car_diagnosis.py): a
-// demand table beside the shipped config, replayed by the PI loop.
-void set_diagnosis_excitation(RigConfig& c, const std::string& table = "quarter_car_diagnosis_demand.csv") {
-  c.profile = ProfileConfig{};
-  c.profile.type = "csv";
-  c.profile.csv_file = (std::filesystem::path(c.file).parent_path() / table).string();
-  c.profile.csv_column = "x_ref";
-  c.profile.filter_tau_s = 0.0;  // the table's edges are already smooth
-}
-
 void make_clean(RigConfig& c) {
-  if (c.case_name.empty()) set_diagnosis_excitation(c);
   c.quarter_car.bearing_friction.enabled = false;
   c.quarter_car.hidden = QuarterCarHiddenEffects{};
-  for (auto& [name, s] : c.sensors) {
-    s.offset = 0.0;
-    s.delay_s = 0.0;
-  }
 }
 
 AppliedEffect apply(RigConfig& c, const std::string& cause, double level) {
@@ -92,7 +77,11 @@ AppliedEffect apply(RigConfig& c, const std::string& cause, double level) {
     // clean excitation never unloads it (lowest load ~0.3 kN). The effect is
     // a run that does: the demand gets a wheel-hop burst, the tyre cannot
     // pull (weak: part of the pull is lost, a tyre glued by its tread).
-    if (c.case_name.empty()) set_diagnosis_excitation(c, "quarter_car_liftoff_demand.csv");
+    // The `diagnosis` case's table with a wheel-hop burst added (beside it).
+    if (c.profile.type == "csv") {
+      c.profile.csv_file =
+          (std::filesystem::path(c.profile.csv_file).parent_path() / "quarter_car_liftoff_demand.csv").string();
+    }
     h.tyre_pull_loss = std::min(1.0, level);
     a.truth = {{"pull_loss", h.tyre_pull_loss}};
     a.description = "wheel-hop burst in the demand and a tyre that cannot pull (weak: part of the pull lost)";
@@ -122,7 +111,7 @@ const RigEffectGenerator& quarter_car_effect_generator() {
       "quarter_car",
       {"bearing_friction", "actuator_seal_friction", "cross_port_leakage", "valve_deadband", "entrained_air",
        "sensor_delay", "sensor_offset", "tyre_liftoff", "damper_asymmetry"},
-      "",  // the excitation is a demand table (set_diagnosis_excitation), not a config case
+      "diagnosis",
       make_clean,
       apply,
   };

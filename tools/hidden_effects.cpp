@@ -6,6 +6,7 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "config/parse_number.hpp"
 #include "tools/hidden_effects_rigs.hpp"
 #include "tools/json_text.hpp"
 #include "tools/run_command.hpp"
@@ -15,17 +16,9 @@ namespace rigctl {
 double parse_effect_level(const std::string& text) {
   if (text == "strong") return 1.0;
   if (text == "weak") return weak_level();
-  std::size_t used = 0;
-  double v = 0.0;
-  try {
-    v = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used != text.size() || !(v > 0.0) || !std::isfinite(v)) {
-    throw std::invalid_argument("effect level '" + text + "': expected weak, strong or a positive number");
-  }
-  return v;
+  const auto v = parse_finite(text);
+  if (!v || !(*v > 0.0)) throw std::invalid_argument("effect level '" + text + "': expected weak, strong or a positive number");
+  return *v;
 }
 
 const RigEffectGenerator& effect_generator(const std::string& rig) {
@@ -57,38 +50,6 @@ void write_truth(const std::string& path, const MakeRunOptions& o, const std::ve
   if (!f) throw std::runtime_error("writing the truth file '" + path + "' failed");
 }
 
-// The simulator's truth channels (sim_*) would give the hidden effect away:
-// the run file keeps only what a rig's transducers measure.
-void drop_truth_columns(const std::string& path) {
-  std::ifstream in(path);
-  std::vector<std::string> lines;
-  for (std::string line; std::getline(in, line);) lines.push_back(line);
-  in.close();
-  std::vector<bool> keep;
-  std::ofstream out(path, std::ios::trunc);
-  for (const auto& line : lines) {
-    if (line.rfind("#", 0) == 0) {
-      out << line << "\n";
-      continue;
-    }
-    std::vector<std::string> cells;
-    std::size_t a = 0;
-    for (std::size_t b; (b = line.find(',', a)) != std::string::npos; a = b + 1) cells.push_back(line.substr(a, b - a));
-    cells.push_back(line.substr(a));
-    if (keep.empty()) {
-      for (const auto& c : cells) keep.push_back(c.rfind("sim_", 0) != 0);
-    }
-    bool first = true;
-    for (std::size_t i = 0; i < cells.size() && i < keep.size(); ++i) {
-      if (!keep[i]) continue;
-      out << (first ? "" : ",") << cells[i];
-      first = false;
-    }
-    out << "\n";
-  }
-  if (!out) throw std::runtime_error("rewriting the run file '" + path + "' failed");
-}
-
 }  // namespace
 
 std::vector<AppliedEffect> make_run(const MakeRunOptions& o, std::ostream& progress) {
@@ -103,6 +64,11 @@ std::vector<AppliedEffect> make_run(const MakeRunOptions& o, std::ostream& progr
   config.driver = "sim";  // the generator never drives hardware
   config.seed = static_cast<uint64_t>(o.seed);
   config.telemetry.lcm_url = "memq://";
+  // Sensor effects (offset, delay) are the same for every rig kind.
+  for (auto& [name, s] : config.sensors) {
+    s.offset = 0.0;
+    s.delay_s = 0.0;
+  }
   gen.make_clean(config);
   std::vector<AppliedEffect> applied;
   for (const auto& [cause, level] : o.effects) {
@@ -117,13 +83,13 @@ std::vector<AppliedEffect> make_run(const MakeRunOptions& o, std::ostream& progr
   run.fast = true;
   run.realtime = false;
   run.csv_path = o.out_csv;
+  run.csv_truth_channels = false;  // the sim_* truth channels would give the hidden effect away
   // The LCM log is only the path to the CSV: kept beside it, removed after.
   run.log_path = o.out_csv + ".lcm";
   std::atomic<bool> stop{false};
   const RunReport report = run_rig(config, run, stop, progress);
   std::filesystem::remove(run.log_path);
   std::filesystem::remove(run.log_path + ".events");  // the event log beside it (SAFETY.md)
-  drop_truth_columns(o.out_csv);
   if (report.loop.final_state != RigState::kStopped) {
     throw std::runtime_error("the generated run ended " + std::string(to_string(report.loop.final_state)) +
                              " (a hidden effect too strong for the rig's limits?)");

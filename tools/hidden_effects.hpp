@@ -38,7 +38,8 @@ struct RigEffectGenerator {
   std::string rig;
   std::vector<std::string> causes;  // every contract cause id of the rig except "none"
   std::string excitation_case;      // `cases:` entry of the rig's shipped config used for diagnosis runs
-  // Switches off every effect the diagnosis library covers (the baseline plant).
+  // Switches off every plant effect the diagnosis library covers (the baseline
+  // plant); make_run itself clears the sensor effects (offset, delay).
   void (*make_clean)(RigConfig& config);
   // Applies one effect at `level`; throws std::invalid_argument for a cause id the rig does not have.
   AppliedEffect (*apply)(RigConfig& config, const std::string& cause, double level);

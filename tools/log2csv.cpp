@@ -69,6 +69,7 @@ void for_each_event(const std::string& path, F&& f) {
 struct Layout {
   std::string rig;
   std::vector<std::string> inputs;
+  std::vector<bool> keep_input;  // written to the file (simulator truth channels may be left out)
   std::string setpoint_name;
   std::vector<std::string> outputs;
   long sample_rate_hz = 0;  // 0 = unknown (fewer than two samples)
@@ -155,7 +156,8 @@ class RowWriter {
     std::fputs(t_text, f_);
     put(p.setpoint);
     for (double v : p.out) put(v);
-    for (double v : p.in) put(v);
+    for (std::size_t i = 0; i < p.in.size(); ++i)
+      if (layout_.keep_input[i]) put(p.in[i]);
     std::fputc('\n', f_);
     ++result.rows;
   }
@@ -176,7 +178,8 @@ void write_head(std::FILE* f, const Layout& layout, const std::string& log_path)
   std::fprintf(f, "# source: rigctl log2csv %s\n", fs::path(log_path).filename().c_str());
   std::fprintf(f, "t,%s", layout.setpoint_name.c_str());
   for (const auto& n : layout.outputs) std::fprintf(f, ",%s", n.c_str());
-  for (const auto& n : layout.inputs) std::fprintf(f, ",%s", n.c_str());
+  for (std::size_t i = 0; i < layout.inputs.size(); ++i)
+    if (layout.keep_input[i]) std::fprintf(f, ",%s", layout.inputs[i].c_str());
   std::fputc('\n', f);
 }
 
@@ -236,11 +239,12 @@ struct TempFile {
 }  // namespace
 
 Log2CsvResult log_to_csv(const std::string& lcm_log_path, const std::string& csv_path,
-                         const std::string& channel_prefix) {
+                         const std::string& channel_prefix, bool simulator_truth) {
   const std::string sample_ch = channel_prefix + "SAMPLE";
   const std::string command_ch = channel_prefix + "COMMAND";
   check_is_lcm_log(lcm_log_path);
-  const Layout layout = scan(lcm_log_path, sample_ch, command_ch);
+  Layout layout = scan(lcm_log_path, sample_ch, command_ch);
+  for (const auto& name : layout.inputs) layout.keep_input.push_back(simulator_truth || name.rfind("sim_", 0) != 0);
 
   TempFile tmp;
   tmp.path = csv_path + ".tmp." + std::to_string(::getpid());

@@ -17,8 +17,10 @@ struct Log2CsvResult {
 // Reads <prefix>SAMPLE and <prefix>COMMAND from the log, joins them by tick
 // and writes csv_path atomically (temp file + rename). Throws
 // std::runtime_error naming the file and the reason when the log is missing,
-// is not an LCM log, or holds no sample/command messages.
+// is not an LCM log, or holds no sample/command messages. simulator_truth
+// false leaves out the simulator's truth channels (sim_*): a run file with
+// only what a rig's transducers measure (the hidden-effect generator's).
 Log2CsvResult log_to_csv(const std::string& lcm_log_path, const std::string& csv_path,
-                         const std::string& channel_prefix = "RIGCTL_");
+                         const std::string& channel_prefix = "RIGCTL_", bool simulator_truth = true);
 
 }  // namespace rigctl

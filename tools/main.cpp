@@ -119,8 +119,7 @@ int main(int argc, char** argv) {
   make_cmd->add_option("--out", make.out_csv, "Run file to write (CSV)")->required();
   make_cmd->add_option("--truth", make.truth_json, "Write what was hidden (JSON)");
 
-  // Authenticated operator commands (issue 7; tools/cmd_command.hpp). The
-  // callback returns the exit code at once so no dispatch below is needed.
+  // Authenticated operator commands (issue 7; tools/cmd_command.hpp).
   rigctl::CmdOptions opcmd;
   auto* opcmd_cmd = app.add_subcommand("cmd", "Send an authenticated operator command to a rig and wait for its acknowledgement (docs/operator-commands.md)");
   opcmd_cmd->add_option("command", opcmd.command, "arm|start|hold|resume|stop|reset|hydraulics-low|hydraulics-high|hydraulics-off|setpoint")->required();
@@ -131,7 +130,6 @@ int main(int argc, char** argv) {
   opcmd_cmd->add_option("--sender", opcmd.sender, "Sender id (default USER@HOSTNAME)");
   opcmd_cmd->add_option("--wait-ack", opcmd.wait_ack_s, "Seconds to wait for the rig's reply; 0: do not wait")->capture_default_str();
   opcmd_cmd->add_option("--state-file", opcmd.state_path, "Sequence state file (default $XDG_STATE_HOME/rigctl/<sender>.seq)");
-  opcmd_cmd->callback([&] { std::exit(rigctl::run_cmd_command(opcmd, std::cout, std::cerr)); });
 
   CLI11_PARSE(app, argc, argv);
 
@@ -159,6 +157,7 @@ int main(int argc, char** argv) {
       rigctl::run_optimize(optimize, std::cout, std::cerr);
       return 0;
     }
+    if (opcmd_cmd->parsed()) return rigctl::run_cmd_command(opcmd, std::cout, std::cerr);
     if (make_cmd->parsed()) {
       for (const auto& e : effect_texts) {
         const auto colon = e.find(':');

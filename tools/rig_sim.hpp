@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "tools/fault_spec.hpp"
+#include "drivers/fault_spec.hpp"
 
 namespace rigctl {
 

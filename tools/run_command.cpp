@@ -228,7 +228,8 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
   if (receiver) out << "  operator commands: " << describe_counters(receiver->counters()) << "\n";
   if (publisher.log_failures() > 0) out << "  run log write failures: " << publisher.log_failures() << "\n";
   if (!report.csv_path.empty()) {
-    const auto csv = log_to_csv(report.log_path, report.csv_path, config.telemetry.channel_prefix);
+    const auto csv =
+        log_to_csv(report.log_path, report.csv_path, config.telemetry.channel_prefix, options.csv_truth_channels);
     out << "  csv: " << report.csv_path << " (" << csv.rows << " rows)\n";
   }
   out.flush();

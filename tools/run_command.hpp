@@ -10,7 +10,7 @@
 
 #include "config/rig_config.hpp"
 #include "rt/rig_loop.hpp"
-#include "tools/fault_spec.hpp"
+#include "drivers/fault_spec.hpp"
 
 namespace rigctl {
 
@@ -22,6 +22,7 @@ struct RunOptions {
   std::string log_path;              // default: <log_dir>/<rig>-<time>.lcm
   std::string events_path;           // event log; default: <log_path>.events
   std::string csv_path;              // optional run-file CSV
+  bool csv_truth_channels = true;    // the simulator's sim_* channels in the CSV too
   std::string lcm_url;               // overrides telemetry.lcm_url
   bool realtime = true;              // false: skip mlockall/SCHED_FIFO (tests)
   // Operator commands from a caller's own source (tests); nullptr: in

@@ -12,7 +12,8 @@ packages=(cmake g++ make pkg-config liblcm-dev liblcm-bin libglib2.0-dev libmodb
           libfmt-dev libeigen3-dev libgtest-dev libgmock-dev libsocketcan-dev libyaml-cpp-dev libcli11-dev libnlopt-cxx-dev libceres-dev
           libboost-dev libbenchmark-dev rt-tests iproute2 socat
           libssl-dev   # libssl-dev: libcrypto HMAC-SHA256 for operator commands
-          libsystemd-dev)  # sd_notify: the service's readiness and watchdog (docs/deployment.md)
+          libsystemd-dev   # sd_notify: the service's readiness and watchdog (docs/deployment.md)
+          systemd)         # systemd-analyze: tests/test_systemd_units.cpp scores the units' hardening
 for arg in "$@"; do
   case "$arg" in
     --plots) packages+=(python3 python3-numpy python3-matplotlib) ;;
@@ -21,19 +22,7 @@ for arg in "$@"; do
   esac
 done
 
-missing=()
-for p in "${packages[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-  echo "setup: installing ${missing[*]}"
-  if [ "$(id -u)" -ne 0 ]; then
-    echo "setup: these Debian packages are missing and installing them needs root: ${missing[*]}" >&2
-    exit 1
-  fi
-  apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}"
-fi
+"$root/tools/install_packages.sh" setup "${packages[@]}"
 
 cmake -S "$root" -B "$root/build" -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
 cmake --build "$root/build" -j"$(nproc)"

@@ -1,4 +1,6 @@
-#include "tools/fault_spec.hpp"
+#include "drivers/fault_spec.hpp"
+
+#include "config/parse_number.hpp"
 
 #include <cmath>
 #include <sstream>
@@ -22,31 +24,17 @@ std::vector<std::string> split(const std::string& s, char sep) {
 }
 
 double seconds(const std::string& spec, const std::string& text, const char* what) {
-  std::size_t used = 0;
-  double v = 0.0;
-  try {
-    v = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != text.size() || !std::isfinite(v) || v < 0.0) {
-    bad(spec, std::string(what) + " '" + text + "' is not a time in seconds >= 0");
-  }
-  return v;
+  const auto v = parse_finite(text);
+  if (!v || *v < 0.0) bad(spec, std::string(what) + " '" + text + "' is not a time in seconds >= 0");
+  return *v;
 }
 
 double number(const std::string& spec, const std::string& text, const char* what, double min) {
-  std::size_t used = 0;
-  double v = 0.0;
-  try {
-    v = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != text.size() || !std::isfinite(v) || v < min) {
+  const auto v = parse_finite(text);
+  if (!v || *v < min) {
     bad(spec, std::string(what) + " '" + text + "' is not a finite number" + (min == 0.0 ? " >= 0" : ""));
   }
-  return v;
+  return *v;
 }
 
 int integer(const std::string& spec, const std::string& text, const char* what) {
