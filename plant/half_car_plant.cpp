@@ -66,7 +66,7 @@ HalfCarState HalfCarPlant::state() const {
 }
 
 void HalfCarPlant::set_state(const HalfCarState& s) {
-  y_ = {s.z_s, s.phi, s.z_u1, s.z_u2, s.v_s, s.omega, s.v_u1, s.v_u2, s.f_act1, s.f_act2, s.f_valve1, s.f_valve2};
+  y_ = to_vec(s);
   t_ = s.time;
   u_ = {s.f_act1, s.f_act2};
 }
@@ -92,7 +92,7 @@ double HalfCarPlant::tyre_force_at(const Vec& y, int wheel, double t) const {
   return std::max(0.0, static_load_[k] + kt * (r.z - zu) + ct * (r.dz - y[kVu1 + k]));
 }
 
-void HalfCarPlant::derivatives(const Vec& y, double t, Vec& dy) const {
+void HalfCarPlant::derivatives(const Vec& y, double t, const Command2& u, Vec& dy) const {
   const auto& p = params_;
   const double k[2] = {p.spring_1, p.spring_2};
   const double c[2] = {p.damper_1, p.damper_2};
@@ -124,42 +124,54 @@ void HalfCarPlant::derivatives(const Vec& y, double t, Vec& dy) const {
     for (std::size_t i = 0; i < 2; ++i) {
       // Command -> valve stage (tau2) -> force loop (tau1); without the valve
       // stage the force loop follows the command directly.
-      const double drive = valve ? y[kValve1 + i] : u_[i];
+      const double drive = valve ? y[kValve1 + i] : u[i];
       dy[kF1 + i] = (drive - y[kF1 + i]) / p.actuator_time_constant;
-      if (valve) dy[kValve1 + i] = (u_[i] - y[kValve1 + i]) / p.actuator_valve_time_constant;
+      if (valve) dy[kValve1 + i] = (u[i] - y[kValve1 + i]) / p.actuator_valve_time_constant;
     }
   }
 }
 
 void HalfCarPlant::rk4(double h) {
   Vec k1, k2, k3, k4, s;
-  derivatives(y_, t_, k1);
+  derivatives(y_, t_, u_, k1);
   for (std::size_t i = 0; i < kN; ++i) s[i] = y_[i] + 0.5 * h * k1[i];
-  derivatives(s, t_ + 0.5 * h, k2);
+  derivatives(s, t_ + 0.5 * h, u_, k2);
   for (std::size_t i = 0; i < kN; ++i) s[i] = y_[i] + 0.5 * h * k2[i];
-  derivatives(s, t_ + 0.5 * h, k3);
+  derivatives(s, t_ + 0.5 * h, u_, k3);
   for (std::size_t i = 0; i < kN; ++i) s[i] = y_[i] + h * k3[i];
-  derivatives(s, t_ + h, k4);
+  derivatives(s, t_ + h, u_, k4);
   for (std::size_t i = 0; i < kN; ++i) y_[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
   t_ += h;
 }
 
 void HalfCarPlant::advance(std::span<const double> command, double dt) {
   if (!(dt > 0.0)) return;
-  for (std::size_t i = 0; i < 2; ++i) {
-    double u = i < command.size() ? command[i] : 0.0;
-    // A non-finite command must not poison the state; the driver flags it.
-    if (!std::isfinite(u)) u = 0.0;
-    if (params_.actuator_force_limit > 0.0) {
-      u = std::clamp(u, -params_.actuator_force_limit, params_.actuator_force_limit);
-    }
-    u_[i] = u;
-    if (params_.actuator_time_constant <= 0.0) y_[kF1 + i] = u;  // ideal force source
-    if (params_.actuator_valve_time_constant <= 0.0) y_[kValve1 + i] = u;  // no valve stage: it passes the command
-  }
+  u_ = held_command(command);
+  hold_command(u_, y_);
   const int n = std::max(1, params_.substeps);
   const double h = dt / n;
   for (int i = 0; i < n; ++i) rk4(h);
+}
+
+HalfCarPlant::Command2 HalfCarPlant::held_command(std::span<const double> command) const {
+  Command2 u{};
+  for (std::size_t i = 0; i < 2; ++i) {
+    double v = i < command.size() ? command[i] : 0.0;
+    // A non-finite command must not poison the state; the driver flags it.
+    if (!std::isfinite(v)) v = 0.0;
+    if (params_.actuator_force_limit > 0.0) {
+      v = std::clamp(v, -params_.actuator_force_limit, params_.actuator_force_limit);
+    }
+    u[i] = v;
+  }
+  return u;
+}
+
+void HalfCarPlant::hold_command(const Command2& u, Vec& y) const {
+  for (std::size_t i = 0; i < 2; ++i) {
+    if (params_.actuator_time_constant <= 0.0) y[kF1 + i] = u[i];  // ideal force source
+    if (params_.actuator_valve_time_constant <= 0.0) y[kValve1 + i] = u[i];  // no valve stage: it passes the command
+  }
 }
 
 double HalfCarPlant::tyre_force(int wheel) const { return tyre_force_at(y_, wheel, t_); }
@@ -172,7 +184,7 @@ bool HalfCarPlant::in_contact(int wheel) const {
 void HalfCarPlant::measure(std::span<double> out) const {
   namespace sig = half_car_signal;
   Vec dy;
-  derivatives(y_, t_, dy);
+  derivatives(y_, t_, u_, dy);
   std::array<double, sig::kCount> v{};
   v[sig::kZr1] = road_.height(0, t_);
   v[sig::kZr2] = road_.height(1, t_);

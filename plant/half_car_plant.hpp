@@ -107,11 +107,25 @@ class HalfCarPlant : public SimulatedPlant {
   const RoadProfile& road() const { return road_; }
   const HalfCarParams& params() const { return params_; }
 
- private:
+  // The continuous model advance() integrates, for other integrators (the
+  // benchmark's adaptive reference, tools/bench_reference.cpp) so that they
+  // integrate these equations, not a copy: the state vector z_s, phi, z_u1,
+  // z_u2, v_s, omega, v_u1, v_u2, f_act1, f_act2, f_valve1, f_valve2 and its
+  // derivative at time t (road, roll moment) under held command u.
   static constexpr std::size_t kN = 12;
   using Vec = std::array<double, kN>;
+  using Command2 = std::array<double, 2>;
+  static Vec to_vec(const HalfCarState& s) {
+    return {s.z_s, s.phi, s.z_u1, s.z_u2, s.v_s, s.omega, s.v_u1, s.v_u2, s.f_act1, s.f_act2, s.f_valve1, s.f_valve2};
+  }
+  // The command as the plant takes it (non-finite -> 0, the force limit).
+  Command2 held_command(std::span<const double> command) const;
+  // What holding u does to the state at once: an ideal actuator (no lag) is
+  // the command, a missing valve stage passes it.
+  void hold_command(const Command2& u, Vec& y) const;
+  void derivatives(const Vec& y, double t, const Command2& u, Vec& dy) const;
 
-  void derivatives(const Vec& y, double t, Vec& dy) const;
+ private:
   void rk4(double h);
   double tyre_force_at(const Vec& y, int wheel, double t) const;
 
@@ -125,7 +139,7 @@ class HalfCarPlant : public SimulatedPlant {
   double roll_moment_full_ = 0.0;
   Vec y_{};
   double t_ = 0.0;
-  std::array<double, 2> u_{};  // command held over the current period
+  Command2 u_{};  // command held over the current period
 };
 
 }  // namespace rigctl

@@ -13,21 +13,6 @@ namespace {
 // State vector layout.
 constexpr std::size_t kTheta = 0, kOmega = 1, kPa = 2, kPb = 3;
 
-int slide_direction(RotaryLoadMode m) {
-  switch (m) {
-    case RotaryLoadMode::kSlidingPositive: return 1;
-    case RotaryLoadMode::kSlidingNegative: return -1;
-    case RotaryLoadMode::kStuck: break;
-  }
-  return 0;
-}
-
-RotaryLoadMode mode_for(int direction) {
-  if (direction > 0) return RotaryLoadMode::kSlidingPositive;
-  if (direction < 0) return RotaryLoadMode::kSlidingNegative;
-  return RotaryLoadMode::kStuck;
-}
-
 }  // namespace
 
 PneumaticRotaryPlant::PneumaticRotaryPlant(const PneumaticRotaryParams& params)
@@ -148,8 +133,10 @@ RotaryLoadMode PneumaticRotaryPlant::mode_at_rest(const Vec& y) const {
 
 // Every mode change starts a new monotone stretch: the hysteresis ramp is
 // re-anchored where the load is now.
-void PneumaticRotaryPlant::enter_mode(RotaryLoadMode mode) {
-  anchor_ = {y_[kTheta], elastic_torque(y_[kTheta])};
+void PneumaticRotaryPlant::enter_mode(RotaryLoadMode mode) { enter_mode_at(mode, y_[kTheta]); }
+
+void PneumaticRotaryPlant::enter_mode_at(RotaryLoadMode mode, double theta) {
+  anchor_ = {theta, elastic_torque(theta)};
   mode_ = mode;
 }
 
@@ -203,9 +190,8 @@ void PneumaticRotaryPlant::substep(double u, double h) {
 
 void PneumaticRotaryPlant::advance(std::span<const double> command, double dt) {
   if (!(dt > 0.0)) return;
-  double u = command.empty() ? 0.0 : command[0];
   // A non-finite command must not poison the state; the driver flags it.
-  if (!std::isfinite(u)) u = 0.0;
+  const double u = held_command(command.empty() ? 0.0 : command[0]);
   u_ = u;
   const int n = std::max(1, params_.substeps);
   const double h = dt / n;

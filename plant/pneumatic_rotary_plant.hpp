@@ -17,6 +17,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <span>
 #include <vector>
@@ -46,6 +47,15 @@ struct PneumaticRotaryState {
   RotaryLoadMode mode = RotaryLoadMode::kStuck;
   HysteresisAnchor anchor;  // memory of the hysteresis ramp (bladder_hysteresis.hpp)
 };
+
+// A sliding mode's direction (+1, -1; 0 when stuck) and the mode for one.
+inline int slide_direction(RotaryLoadMode m) {
+  return m == RotaryLoadMode::kSlidingPositive ? 1 : (m == RotaryLoadMode::kSlidingNegative ? -1 : 0);
+}
+inline RotaryLoadMode mode_for(int direction) {
+  return direction > 0 ? RotaryLoadMode::kSlidingPositive
+                       : (direction < 0 ? RotaryLoadMode::kSlidingNegative : RotaryLoadMode::kStuck);
+}
 
 // Indices into measure()'s output, in signals() order.
 namespace pneumatic_rotary_signal {
@@ -122,17 +132,28 @@ class PneumaticRotaryPlant : public SimulatedPlant {
   double brake_level() const { return brake_; }  // T_c [N m]
   const PneumaticRotaryParams& params() const { return params_; }
 
- private:
-  static constexpr std::size_t kN = 4;  // theta, omega, p_a, p_b
+  // The continuous model advance() integrates, for other integrators (the
+  // benchmark's adaptive reference, tools/bench_reference.cpp) so that they
+  // integrate these equations, not a copy: the state vector theta, omega,
+  // p_a, p_b, its derivative in a given mode under the present hysteresis
+  // anchor, and the pieces of the stick/slip decision.
+  static constexpr std::size_t kN = 4;
   using Vec = std::array<double, kN>;
-
+  static constexpr std::size_t kOmegaIndex = 1;
+  static double held_command(double u) { return std::isfinite(u) ? u : 0.0; }
   void derivatives(const Vec& y, double t, RotaryLoadMode mode, double u, Vec& dy) const;
+  double residual_torque(const Vec& y) const;  // load torque the holding band must resist
+  RotaryLoadMode mode_at_rest(const Vec& y) const;
+  // Enters `mode` at angle theta: the hysteresis ramp is re-anchored there.
+  void enter_mode_at(RotaryLoadMode mode, double theta);
+  bool stick_slip() const { return stick_slip_; }
+  double holding_torque() const { return holding_; }  // h_s + T_c [N m]
+
+ private:
   void rk4(Vec& y, double t, RotaryLoadMode mode, double u, double h) const;
   void substep(double u, double h);
   double end_stop_torque(double theta, double omega) const;
   double elastic_torque(double theta) const;
-  double residual_torque(const Vec& y) const;
-  RotaryLoadMode mode_at_rest(const Vec& y) const;
   void enter_mode(RotaryLoadMode mode);
 
   PneumaticRotaryParams params_;

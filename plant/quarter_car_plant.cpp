@@ -17,12 +17,6 @@ constexpr std::size_t kXs = 0, kP1 = 1, kP2 = 2, kXr = 3, kVr = 4, kXw = 5, kVw 
 // keeps beta/V finite instead of dividing by zero or a negative volume.
 constexpr double kMinVolume = 1e-9;
 
-int slide_direction(BearingMode m) { return m == BearingMode::kSlidingDown ? -1 : 1; }
-
-BearingMode sliding_mode(double force) {
-  return force >= 0.0 ? BearingMode::kSlidingUp : BearingMode::kSlidingDown;
-}
-
 // exp(x) - 1 - x without the cancellation of the direct form at small x
 // (oil energies are ~1e-2 of P V, and the energy test resolves 1e-9 of them).
 double expm1_minus_x(double x) {
@@ -98,7 +92,7 @@ QuarterCarState QuarterCarPlant::state() const {
 }
 
 void QuarterCarPlant::set_state(const QuarterCarState& s) {
-  y_ = {s.x_s, s.p1, s.p2, s.x_r, s.v_r, s.x_w, s.v_w, s.x_b, s.v_b};
+  y_ = to_vec(s);
   mode_ = s.bearing;
   if (params_.bearing_friction.enabled && s.v_b != 0.0) mode_ = sliding_mode(s.v_b);
 }
@@ -226,7 +220,6 @@ void QuarterCarPlant::apply_floors(Vec& y) const {
 }
 
 BearingMode QuarterCarPlant::mode_at_rest(const Vec& y) const {
-  const auto& p = params_;
   const double f_susp = suspension_force(y);
   if (std::abs(f_susp) > levels_at(y).breakaway) return sliding_mode(f_susp);
   return BearingMode::kStuck;
@@ -279,10 +272,8 @@ void QuarterCarPlant::substep(double u, double h) {
 
 void QuarterCarPlant::advance(std::span<const double> command, double dt) {
   if (!(dt > 0.0)) return;
-  double u = command.empty() ? 0.0 : command[0];
   // A non-finite command must not poison the state; the driver flags it.
-  if (!std::isfinite(u)) u = 0.0;
-  u = std::clamp(u, -1.0, 1.0);
+  const double u = held_command(command.empty() ? 0.0 : command[0]);
   const int n = std::max(1, params_.substeps);
   const double h = dt / n;
   for (int i = 0; i < n; ++i) substep(u, h);

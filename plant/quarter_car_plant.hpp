@@ -4,7 +4,9 @@
 // shared/rig-parameters.md section 1 "Equations (nominal)".
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <span>
 #include <vector>
@@ -36,6 +38,13 @@ struct QuarterCarState {
   double v_b = 0.0;  // [m/s]
   BearingMode bearing = BearingMode::kStuck;
 };
+
+// The bearing's slide direction (+1 up, -1 down) and the sliding mode a
+// force breaks away into.
+inline int slide_direction(BearingMode m) { return m == BearingMode::kSlidingDown ? -1 : 1; }
+inline BearingMode sliding_mode(double force) {
+  return force >= 0.0 ? BearingMode::kSlidingUp : BearingMode::kSlidingDown;
+}
 
 // Indices into measure()'s output, in signals() order.
 namespace quarter_car_signal {
@@ -138,19 +147,29 @@ class QuarterCarPlant : public SimulatedPlant {
     if (chamber == 1 || chamber == 2) chamber_leak_[static_cast<std::size_t>(chamber - 1)] = k;
   }
 
- private:
+  // The continuous model advance() integrates, for other integrators (the
+  // benchmark's adaptive reference, tools/bench_reference.cpp) so that they
+  // integrate these equations, not a copy: the state vector x_s, p1, p2,
+  // x_r, v_r, x_w, v_w, x_b, v_b, its derivative in a given bearing mode,
+  // and the pieces of the stick/slip decision. With params().hidden and the
+  // fault hooks applied, as in advance().
   static constexpr std::size_t kN = 9;
   using Vec = std::array<double, kN>;
-
+  static Vec to_vec(const QuarterCarState& s) { return {s.x_s, s.p1, s.p2, s.x_r, s.v_r, s.x_w, s.v_w, s.x_b, s.v_b}; }
+  static constexpr std::size_t kVbIndex = 8;
+  // The command as the plant takes it: non-finite -> 0, clamped to [-1, 1]
+  // (the valve amplifier saturates there).
+  static double held_command(double u) { return std::isfinite(u) ? std::clamp(u, -1.0, 1.0) : 0.0; }
   void derivatives(const Vec& y, BearingMode mode, double u, Vec& dy) const;
+  void apply_floors(Vec& y) const;  // the cavitation floor of both chambers
+  BearingMode mode_at_rest(const Vec& y) const;
+  BearingFrictionLevels levels_at(const Vec& y) const;
+  double suspension_force(const Vec& y) const;
+
+ private:
   void rk4(Vec& y, BearingMode mode, double u, double h) const;
   void substep(double u, double h);
-  void apply_floors(Vec& y) const;
-  BearingMode mode_at_rest(const Vec& y) const;
   void settle_mode();
-  BearingFrictionLevels levels_at(const Vec& y) const;
-  // With params_.hidden applied (nominal when it is default).
-  double suspension_force(const Vec& y) const;
   double tyre_force(const Vec& y) const;
   double seal_friction(double v_r, double p1, double p2) const;
   double effective_bulk_modulus(double p) const;

@@ -5,13 +5,13 @@
 // (bearing stick/slip, load stick/slip and hysteresis re-anchoring) located
 // to ~1e-13 s by bisection instead of at sub-step ends.
 //
-// The right-hand sides here restate the plants' equations from their public
-// building blocks (valve_flows, bearing friction, bladder hysteresis, the
-// half car's road and lever arms), since the plants keep derivatives()
-// private. So that the reference cannot silently drift from the model it
-// checks, rhs_agreement_*() steps both from the same states with one RK4
-// step and reports the largest relative difference (about 1e-13 when they
-// agree); the bench prints it beside every error figure.
+// The right-hand sides are the plants' own (their public derivatives() and
+// stick/slip pieces): the reference integrates the same equations, hidden
+// effects and fault hooks included. What is the reference's own is the event
+// handling and the composition of a step; rhs_agreement_*() checks that by
+// stepping both from the same states with one RK4 step and reporting the
+// largest relative difference (about 1e-13 when they agree); the bench prints
+// it beside every error figure.
 //
 // This is the only file that includes Boost.Odeint (heavy to compile).
 #pragma once
