@@ -242,6 +242,7 @@ Diagnosis diagnose(const RigModel& model, const DiagnoseOptions& opt) {
       double se;
     };
     std::vector<Refit> refits;
+    const double neff = n_eff(current);  // every candidate of the round is compared at this one
     for (std::size_t c = 0; c < cands.size(); ++c) {
       ScreenedCandidate sc;
       sc.cause = effects[cands[c].e].cause;
@@ -317,7 +318,6 @@ Diagnosis diagnose(const RigModel& model, const DiagnoseOptions& opt) {
       if (reason.empty() && !significant) reason = "effect strength not significant (< 3 sigma)";
       std::size_t k_cur = L.n_base, k_new = L.n_base + effects[e].params.size();
       for (auto a : active) k_cur += effects[a].params.size(), k_new += effects[a].params.size();
-      const double neff = n_eff(current);
       if (reason.empty() && !(bic(s, k_new, neff) < bic(current, k_cur, neff))) reason = "BIC (with N_eff) not lower";
       sc.refitted = true;
       sc.gain_percent_points = gain;

@@ -36,7 +36,7 @@ AppliedEffect apply(RigConfig& c, const std::string& cause, double level) {
     a.description = "body-bearing Karnopp stick/slip friction at the nominal levels x level";
   } else if (cause == "actuator_seal_friction") {
     // 150 N preload + 5e-6 N/Pa x (p1 + p2) (about 100 N at the ~200 bar sum):
-    // about 1 % of the rod force in a step, a few per cent of the valve command.
+    // about 1 % of the ~20 kN rod force of a step (A1 p1).
     h.seal_preload = 150.0 * level;
     h.seal_pressure_coefficient = 5e-6 * level;
     h.seal_viscous = 300.0 * level;
