@@ -40,7 +40,7 @@ int64_t wall_utime() {
 }  // namespace
 
 EventLog::EventLog(std::string path, EventLogMeta meta)
-    : path_(std::move(path)), meta_(std::move(meta)), queue_(kQueueCapacity) {
+    : path_(std::move(path)), meta_(std::move(meta)), queue_(kQueueCapacity, meta_.queue_policy) {
   const std::filesystem::path parent = std::filesystem::path(path_).parent_path();
   std::error_code ec;
   if (!parent.empty()) std::filesystem::create_directories(parent, ec);
@@ -50,11 +50,7 @@ EventLog::EventLog(std::string path, EventLogMeta meta)
 
 EventLog::~EventLog() { stop(); }
 
-bool EventLog::push(const EventRecord& record) noexcept {
-  if (queue_.try_push(record)) return true;
-  dropped_.fetch_add(1, std::memory_order_relaxed);
-  return false;
-}
+bool EventLog::push(const EventRecord& record) noexcept { return queue_.push(record); }
 
 void EventLog::push_note(int64_t wall_utime, const std::string& code, const std::string& source, int64_t sequence,
                          const std::string& message) {
@@ -142,7 +138,7 @@ void EventLog::flush_pending() {
 void EventLog::drain() {
   EventRecord r;
   bool any = false;
-  while (queue_.try_pop(r)) {
+  while (queue_.pop(r)) {
     if (pending_.size() < kMaxPendingLines) pending_.push_back(format(r));
     any = true;
   }
@@ -160,9 +156,12 @@ void EventLog::start() {
   if (thread_.joinable()) return;
   pending_.push_back("# rigctl event log: rig " + meta_.rig + ", opened " + iso_utc(wall_utime()) +
                      "; one line per event: wall time (UTC), rig time t [s], tick, state after the event, code, "
-                     "channel, value, source, message");
+                     "channel, value, source, message; a full queue: " +
+                     (meta_.queue_policy == QueueFullPolicy::kWait ? std::string("the loop waits (simulated time)")
+                                                                     : std::string("dropped and counted (paced run)")));
   flush_pending();
   running_.store(true);
+  queue_.set_consumer_running(true);
   thread_ = std::thread([this] { thread_main(); });
 }
 
@@ -182,11 +181,12 @@ void EventLog::thread_main() {
 void EventLog::stop() {
   if (stopped_) return;
   stopped_ = true;
+  queue_.set_consumer_running(false);
   running_.store(false);
   if (thread_.joinable()) thread_.join();
   drain();
   pending_.push_back("# closed cleanly " + iso_utc(wall_utime()) + ": " + std::to_string(written_.load()) +
-                     " lines written, " + std::to_string(dropped_.load()) + " dropped");
+                     " lines written, " + std::to_string(queue_.dropped()) + " dropped");
   flush_pending();
   if (fd_ >= 0) ::close(fd_);
   fd_ = -1;
@@ -197,7 +197,7 @@ EventLogStats EventLog::stats() const {
   s.written = written_.load();
   s.pending = pending_count_.load();
   s.write_failures = failures_.load();
-  s.dropped = dropped_.load();
+  s.dropped = queue_.dropped();
   s.max_fsync_ms = static_cast<double>(max_fsync_ns_.load()) * 1e-6;
   return s;
 }

@@ -4,8 +4,9 @@
 // the disk within a poll period (1 ms) plus one fsync of the moment it
 // happened; a kill -9 of the controller loses none that were written.
 //
-// The loop pushes fixed-size EventRecords into a lock-free queue and never
-// waits. A failing disk (full, I/O error) is reported through on_failure
+// The loop pushes fixed-size EventRecords into a lock-free queue; a paced
+// loop never waits, one in simulated time waits when the queue is full
+// (EventLogMeta::queue_policy, rt/queue_full_policy.hpp). A failing disk (full, I/O error) is reported through on_failure
 // (console and LCM); the lines are kept in memory (up to kMaxPendingLines)
 // and retried once a second, so a disk that frees up still gets them all.
 #pragma once
@@ -18,9 +19,10 @@
 #include <string>
 #include <thread>
 
+#include "rt/bounded_handoff.hpp"
 #include "rt/event_sink.hpp"
+#include "rt/queue_full_policy.hpp"
 #include "rt/sample.hpp"
-#include "rt/spsc_queue.hpp"
 
 namespace rigctl {
 
@@ -28,13 +30,14 @@ struct EventLogMeta {
   std::string rig;
   ChannelLayout layout;      // channel names for the messages
   int64_t start_utime = 0;   // wall-clock time of rig time 0 [us since the epoch], as the LCM log
+  QueueFullPolicy queue_policy = QueueFullPolicy::kDrop;  // as the telemetry's: the loop's clock decides
 };
 
 struct EventLogStats {
   int64_t written = 0;       // lines on the disk (fsync'd)
   int64_t pending = 0;       // lines waiting for a disk that failed
   int64_t write_failures = 0;
-  int64_t dropped = 0;       // refused by a full queue (never seen in practice: 4096 slots)
+  int64_t dropped = 0;       // refused by a full queue (kDrop only; never seen in practice: 4096 slots)
   double max_fsync_ms = 0.0;  // longest write + fsync of one line
 };
 
@@ -50,7 +53,7 @@ class EventLog final : public EventSink {
   EventLog(const EventLog&) = delete;
   EventLog& operator=(const EventLog&) = delete;
 
-  // Loop thread: never blocks.
+  // Loop thread: kDrop never blocks; kWait waits for the writer when full.
   bool push(const EventRecord& record) noexcept override;
 
   // Other (non-real-time) threads: an event the loop never saw, e.g. an
@@ -83,7 +86,7 @@ class EventLog final : public EventSink {
   std::string path_;
   EventLogMeta meta_;
   int fd_ = -1;
-  SpscQueue<EventRecord> queue_;
+  BoundedHandoff<EventRecord> queue_;
   std::thread thread_;
   std::atomic<bool> running_{false};
   bool stopped_ = false;
@@ -91,7 +94,7 @@ class EventLog final : public EventSink {
   std::mutex notes_mutex_;
   std::deque<std::string> notes_;    // push_note() lines, guarded by notes_mutex_
   std::function<void(const std::string&)> on_failure_;
-  std::atomic<int64_t> written_{0}, failures_{0}, dropped_{0}, pending_count_{0};
+  std::atomic<int64_t> written_{0}, failures_{0}, pending_count_{0};
   std::atomic<int64_t> max_fsync_ns_{0};
 };
 

@@ -83,7 +83,7 @@ int emit(lcm::LCM& lcm, lcm::LogFile* log, const std::string& channel, int64_t u
 
 TelemetryPublisher::TelemetryPublisher(TelemetryMeta meta, const std::string& lcm_url,
                                        const std::string& log_path, std::size_t queue_capacity)
-    : meta_(std::move(meta)), channels_(meta_.channel_prefix), queue_(queue_capacity) {
+    : meta_(std::move(meta)), channels_(meta_.channel_prefix), queue_(queue_capacity, meta_.queue_policy) {
   // The record has fixed-size arrays: refuse a layout that would be cut short
   // in the messages rather than silently drop channels.
   auto check_size = [](std::size_t n, std::size_t max, const char* what) {
@@ -117,11 +117,7 @@ TelemetryPublisher::TelemetryPublisher(TelemetryMeta meta, const std::string& lc
 
 TelemetryPublisher::~TelemetryPublisher() { stop(); }
 
-bool TelemetryPublisher::push(const TelemetryRecord& record) noexcept {
-  if (queue_.try_push(record)) return true;
-  dropped_.fetch_add(1, std::memory_order_relaxed);
-  return false;
-}
+bool TelemetryPublisher::push(const TelemetryRecord& record) noexcept { return queue_.push(record); }
 
 void TelemetryPublisher::set_diagnostics_source(std::function<DriverDiagnostics()> source, std::string driver_name) {
   diagnostics_ = std::move(source);
@@ -148,18 +144,20 @@ void TelemetryPublisher::publish_driver_status() {
 void TelemetryPublisher::start() {
   if (thread_.joinable()) return;
   running_.store(true);
+  queue_.set_consumer_running(true);
   thread_ = std::thread([this] { thread_main(); });
 }
 
 void TelemetryPublisher::stop() {
   if (stopped_) return;  // the destructor calls it again
   stopped_ = true;
+  queue_.set_consumer_running(false);
   running_.store(false);
   if (thread_.joinable()) thread_.join();
   // Whatever the loop pushed before stop() still goes out (also when the
   // thread was never started).
   TelemetryRecord record;
-  while (queue_.try_pop(record)) publish_record(record);
+  while (queue_.pop(record)) publish_record(record);
   publish_driver_status();
   publish_reports();
   flush_log();
@@ -224,7 +222,7 @@ void TelemetryPublisher::thread_main() {
   auto last_status = last_flush;
   TelemetryRecord record;
   while (running_.load()) {
-    const bool got = queue_.try_pop(record);
+    const bool got = queue_.pop(record);
     if (got) publish_record(record);
     const auto now = Clock::now();
     if (now - last_flush >= kLogFlushInterval) {
@@ -315,6 +313,7 @@ void TelemetryPublisher::publish_record(const TelemetryRecord& r) {
     m.tick = r.tick;
     m.period_ns = tm.period_ns;
     m.overrun_policy = meta_.overrun_policy;
+    m.queue_policy = to_string(meta_.queue_policy);
     m.ticks = tm.ticks;
     m.overruns = tm.overruns;
     m.missed_ticks = tm.missed_ticks;

@@ -15,8 +15,9 @@
 #include <vector>
 
 #include "drivers/driver.hpp"
+#include "rt/bounded_handoff.hpp"
+#include "rt/queue_full_policy.hpp"
 #include "rt/sample.hpp"
-#include "rt/spsc_queue.hpp"
 #include "rt/telemetry_record.hpp"
 #include "rt/telemetry_sink.hpp"
 
@@ -36,6 +37,9 @@ struct TelemetryMeta {
   std::vector<std::string> term_names;  // controller terms, e.g. {"p", "i"}
   std::string channel_prefix = "RIGCTL_";
   std::string overrun_policy = "skip";
+  // A full queue: kDrop for paced runs, kWait (backpressure) in simulated
+  // time (rt/queue_full_policy.hpp). Published in every timing message.
+  QueueFullPolicy queue_policy = QueueFullPolicy::kDrop;
   int64_t period_ns = 2'500'000;
   // Wall-clock time of tick 0 [us since the epoch]. Message utime and log
   // event timestamps are start_utime + rig time, so a --fast run and a paced
@@ -63,7 +67,8 @@ class TelemetryPublisher final : public TelemetrySink {
   TelemetryPublisher(const TelemetryPublisher&) = delete;
   TelemetryPublisher& operator=(const TelemetryPublisher&) = delete;
 
-  // Real-time side: never blocks. Returns false and counts a drop when full.
+  // Loop side. kDrop: never blocks, returns false and counts a drop when
+  // full. kWait: waits for the publisher thread to make room.
   bool push(const TelemetryRecord& record) noexcept override;
 
   // Polled about once a second (and at stop) for the driver's counters and
@@ -79,7 +84,9 @@ class TelemetryPublisher final : public TelemetrySink {
   void stop();   // drains the queue, flushes and closes the log, joins the thread
 
   int64_t published() const { return published_.load(); }
-  int64_t dropped() const { return dropped_.load(); }
+  int64_t dropped() const { return queue_.dropped(); }
+  int64_t queue_waits() const { return queue_.waits(); }  // kWait: pushes that found the queue full
+  QueueFullPolicy queue_policy() const { return queue_.policy(); }
   const TelemetryChannels& channels() const { return channels_; }
   // The LCM instance, so in-process subscribers (memq://) can share it.
   lcm::LCM& lcm();
@@ -100,11 +107,10 @@ class TelemetryPublisher final : public TelemetrySink {
   TelemetryChannels channels_;
   std::unique_ptr<lcm::LCM> lcm_;
   std::unique_ptr<lcm::LogFile> log_;
-  SpscQueue<TelemetryRecord> queue_;
+  BoundedHandoff<TelemetryRecord> queue_;
   std::thread thread_;
   std::atomic<bool> running_{false};
   std::atomic<int64_t> published_{0};
-  std::atomic<int64_t> dropped_{0};
   mutable std::mutex latest_mutex_;
   std::optional<TelemetryRecord> latest_;
   std::function<DriverDiagnostics()> diagnostics_;

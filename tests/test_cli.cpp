@@ -15,12 +15,11 @@
 #include <regex>
 #include <sstream>
 
+#include "log_messages.hpp"
 #include "process.hpp"
 #include "read_file.hpp"
-#include "rigctl/command_t.hpp"
-#include "rigctl/controller_t.hpp"
-#include "rigctl/sample_t.hpp"
 
+using rigctl::test::data_messages;
 using rigctl::test::run_command;
 namespace fs = std::filesystem;
 
@@ -43,30 +42,6 @@ class CliTest : public ::testing::Test {
 };
 
 using rigctl::test::read_file;
-
-// The log's data messages with their wall-clock utime cleared, re-encoded:
-// what must agree between two runs of the same config and seed.
-template <typename Msg>
-void append_normalised(const lcm::LogEvent& e, std::vector<std::string>& out) {
-  Msg m;
-  if (m.decode(e.data, 0, e.datalen) < 0) throw std::runtime_error("cannot decode " + e.channel);
-  m.utime = 0;
-  std::string bytes(static_cast<std::size_t>(m.getEncodedSize()), '\0');
-  m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
-  out.push_back(e.channel + ":" + bytes);
-}
-
-std::vector<std::string> data_messages(const std::string& log_path) {
-  lcm::LogFile log(log_path, "r");
-  EXPECT_TRUE(log.good()) << log_path;
-  std::vector<std::string> out;
-  while (const lcm::LogEvent* e = log.readNextEvent()) {
-    if (e->channel == "RIGCTL_SAMPLE") append_normalised<rigctl::sample_t>(*e, out);
-    if (e->channel == "RIGCTL_COMMAND") append_normalised<rigctl::command_t>(*e, out);
-    if (e->channel == "RIGCTL_CONTROLLER") append_normalised<rigctl::controller_t>(*e, out);
-  }
-  return out;
-}
 
 }  // namespace
 

@@ -143,7 +143,8 @@ TEST_F(Log2CsvTest, PublisherLogBecomesRunFile) {
 
   const Csv c = read_csv(csv);
   EXPECT_EQ(c.meta, (std::vector<std::string>{"# rig: quarter_car", "# sample_rate_hz: 400",
-                                              "# source: rigctl log2csv run.lcm"}));
+                                              "# source: rigctl log2csv run.lcm",
+                                              "# telemetry_queue_policy: drop", "# dropped_records: 0"}));
   const std::vector<std::string> header = {"t", "x_ref", "u", "x_r", "x_w", "x_b", "v_w",
                                            "v_b", "p1", "p2", "f_t", "sim_x_b"};
   ASSERT_EQ(c.header, header);

@@ -90,6 +90,12 @@ std::vector<AppliedEffect> make_run(const MakeRunOptions& o, std::ostream& progr
   const RunReport report = run_rig(config, run, stop, progress);
   std::filesystem::remove(run.log_path);
   std::filesystem::remove(run.log_path + ".events");  // the event log beside it (SAFETY.md)
+  // Simulated time waits for the publisher instead of dropping
+  // (rt/queue_full_policy.hpp): a gap here is a bug, never a run file.
+  if (report.loop.dropped_records > 0) {
+    throw std::runtime_error("the generated run lost " + std::to_string(report.loop.dropped_records) +
+                             " telemetry records");
+  }
   if (report.loop.final_state != RigState::kStopped) {
     throw std::runtime_error("the generated run ended " + std::string(to_string(report.loop.final_state)) +
                              " (a hidden effect too strong for the rig's limits?)");

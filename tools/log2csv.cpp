@@ -22,6 +22,7 @@
 
 #include "rigctl/command_t.hpp"
 #include "rigctl/sample_t.hpp"
+#include "rigctl/timing_t.hpp"
 
 namespace rigctl {
 
@@ -73,6 +74,10 @@ struct Layout {
   std::string setpoint_name;
   std::vector<std::string> outputs;
   long sample_rate_hz = 0;  // 0 = unknown (fewer than two samples)
+  // From the newest timing message: what a full telemetry queue did and how
+  // many records it dropped, so a run file says whether it is complete.
+  std::string queue_policy;  // "" = no timing message in the log
+  int64_t dropped_records = 0;
 };
 
 long median_rate(std::vector<std::pair<int64_t, double>> tick_t) {
@@ -89,7 +94,8 @@ long median_rate(std::vector<std::pair<int64_t, double>> tick_t) {
   return std::lround(1.0 / *mid);
 }
 
-Layout scan(const std::string& path, const std::string& sample_ch, const std::string& command_ch) {
+Layout scan(const std::string& path, const std::string& sample_ch, const std::string& command_ch,
+            const std::string& timing_ch) {
   Layout layout;
   bool have_sample = false;
   bool have_command = false;
@@ -110,6 +116,11 @@ Layout scan(const std::string& path, const std::string& sample_ch, const std::st
       layout.setpoint_name = c.setpoint_name;
       layout.outputs = c.names;
       have_command = true;
+    } else if (ev.channel == timing_ch) {
+      rigctl::timing_t m;
+      if (!decode(ev, m)) return;
+      layout.queue_policy = m.queue_policy;
+      layout.dropped_records = m.dropped_records;
     }
   });
   if (!have_sample) fail(path, "no sample messages on channel " + sample_ch);
@@ -176,6 +187,10 @@ void write_head(std::FILE* f, const Layout& layout, const std::string& log_path)
   std::fprintf(f, "# rig: %s\n", layout.rig.c_str());
   if (layout.sample_rate_hz > 0) std::fprintf(f, "# sample_rate_hz: %ld\n", layout.sample_rate_hz);
   std::fprintf(f, "# source: rigctl log2csv %s\n", fs::path(log_path).filename().c_str());
+  if (!layout.queue_policy.empty()) {
+    std::fprintf(f, "# telemetry_queue_policy: %s\n", layout.queue_policy.c_str());
+    std::fprintf(f, "# dropped_records: %lld\n", static_cast<long long>(layout.dropped_records));
+  }
   std::fprintf(f, "t,%s", layout.setpoint_name.c_str());
   for (const auto& n : layout.outputs) std::fprintf(f, ",%s", n.c_str());
   for (std::size_t i = 0; i < layout.inputs.size(); ++i)
@@ -243,7 +258,7 @@ Log2CsvResult log_to_csv(const std::string& lcm_log_path, const std::string& csv
   const std::string sample_ch = channel_prefix + "SAMPLE";
   const std::string command_ch = channel_prefix + "COMMAND";
   check_is_lcm_log(lcm_log_path);
-  Layout layout = scan(lcm_log_path, sample_ch, command_ch);
+  Layout layout = scan(lcm_log_path, sample_ch, command_ch, channel_prefix + "TIMING");
   for (const auto& name : layout.inputs) layout.keep_input.push_back(simulator_truth || name.rfind("sim_", 0) != 0);
 
   TempFile tmp;
@@ -253,6 +268,7 @@ Log2CsvResult log_to_csv(const std::string& lcm_log_path, const std::string& csv
 
   Log2CsvResult result;
   result.rig = layout.rig;
+  result.dropped_records = layout.dropped_records;
   write_head(tmp.f, layout, lcm_log_path);
   RowWriter writer(tmp.f, layout);
   join_and_write(lcm_log_path, sample_ch, command_ch, writer, result);

@@ -12,6 +12,7 @@ struct Log2CsvResult {
   int64_t rows = 0;     // data rows written
   int64_t skipped = 0;  // ticks not written: a message missing, invalid or non-finite input, t not increasing
   std::string rig;      // from sample_t.rig
+  int64_t dropped_records = 0;  // telemetry records the run's queue dropped (newest timing message)
 };
 
 // Reads <prefix>SAMPLE and <prefix>COMMAND from the log, joins them by tick

@@ -48,6 +48,9 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--log", run.log_path, "LCM log file to write (default: a new file in the config's log_dir)");
   run_cmd->add_option("--csv", run.csv_path, "Also write the run as a CSV run file");
   run_cmd->add_option("--events", run.events_path, "Event log to append to (default: <log>.events; SAFETY.md)");
+  run_cmd->add_option("--telemetry-queue", run.telemetry_queue_records,
+                      "Records the loop can hand to the publisher before its queue is full (default: 10 s of ticks); "
+                      "full: a paced run drops and counts, a --fast run waits")->check(CLI::PositiveNumber);
   run_cmd->add_option("--lcm-url", run.lcm_url, "LCM URL, overrides telemetry.lcm_url (e.g. udpm://239.255.76.67:7667?ttl=1)");
   run_cmd->add_flag("--no-realtime{false}", run.realtime, "Do not try mlockall/SCHED_FIFO");
   run_cmd->add_flag("--operator", run.operator_mode, "Operator mode whatever safety.auto_sequence says: power up faulted, move only on `rigctl cmd` (docs/deployment.md)");

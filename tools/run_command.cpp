@@ -107,17 +107,22 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
   meta.overrun_policy = std::string(to_string(config.loop.overrun_policy));
   meta.period_ns = loop_options.period_ns;
   meta.start_utime = wall_utime_now();
+  // Simulated time has no deadline to keep: a full queue holds the loop back
+  // instead of losing records (rt/queue_full_policy.hpp).
+  meta.queue_policy = options.fast ? QueueFullPolicy::kWait : QueueFullPolicy::kDrop;
   const std::string url = options.lcm_url.empty() ? config.telemetry.lcm_url : options.lcm_url;
-  // Ten seconds of records: the publisher thread would have to stall that
-  // long before the loop drops telemetry.
-  const auto queue_capacity = static_cast<std::size_t>(10.0 / config.loop.period_s);
+  // Ten seconds of records: a paced run's publisher thread would have to
+  // stall that long before the loop drops telemetry.
+  const auto queue_capacity = options.telemetry_queue_records > 0
+                                  ? options.telemetry_queue_records
+                                  : static_cast<std::size_t>(10.0 / config.loop.period_s);
   TelemetryPublisher publisher(meta, url, report.log_path, queue_capacity);
   Driver* driver = rig.driver.get();
   publisher.set_diagnostics_source([driver] { return driver->diagnostics(); }, config.driver);
 
   // The event log: every state change, trip and command, fsync'd per line.
   report.events_path = options.events_path.empty() ? report.log_path + ".events" : options.events_path;
-  EventLog events(report.events_path, EventLogMeta{config.rig, rig.driver->layout(), meta.start_utime});
+  EventLog events(report.events_path, EventLogMeta{config.rig, rig.driver->layout(), meta.start_utime, meta.queue_policy});
   events.set_failure_handler([&publisher](const std::string& text) {
     spdlog::error("{}", text);
     publisher.report_event("log_write_failed", text);
@@ -147,7 +152,10 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
       << (options.case_name.empty() ? "" : " case " + options.case_name) << ", "
       << (unbounded ? std::string("until stopped") : fmt::format("{:g} s", duration)) << " "
       << (options.fast ? "as fast as possible" : "paced by the real clock") << "\n"
-      << "  telemetry: " << url << " channels " << config.telemetry.channel_prefix << "*\n";
+      << "  telemetry: " << url << " channels " << config.telemetry.channel_prefix << "*, a full queue "
+      << (meta.queue_policy == QueueFullPolicy::kWait ? "holds the loop back (simulated time: nothing is dropped)"
+                                                       : "drops and counts (the tick never waits)")
+      << "\n";
   if (receiver) {
     out << "  operator mode: the rig powers up faulted; commands on " << receiver->channel() << " (acks on "
         << receiver->ack_channel() << ")\n";
@@ -220,6 +228,9 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
         << to_string(config.loop.overrun_policy) << ")\n";
   }
   if (report.loop.dropped_records > 0) out << "  telemetry records dropped: " << report.loop.dropped_records << "\n";
+  if (publisher.queue_waits() > 0) {
+    out << "  telemetry queue full " << publisher.queue_waits() << " times: the loop waited for the publisher\n";
+  }
   out << "  log: " << report.log_path << "\n";
   const EventLogStats es = events.stats();
   out << "  events: " << report.events_path << " (" << es.written << " lines, " << std::setprecision(2)

@@ -19,6 +19,9 @@ struct RunOptions {
   std::string case_name;             // a `cases:` entry of the config, "" for none
   std::optional<double> duration_s;  // default: the profile's length; operator mode: until the operator ends it
   bool fast = false;                 // simulated plant only: no pacing
+  // Telemetry records the loop can hand over before the queue is full;
+  // 0: ten seconds of ticks. A small queue shows the full-queue policy at work.
+  std::size_t telemetry_queue_records = 0;
   std::string log_path;              // default: <log_dir>/<rig>-<time>.lcm
   std::string events_path;           // event log; default: <log_path>.events
   std::string csv_path;              // optional run-file CSV
