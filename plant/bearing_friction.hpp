@@ -1,5 +1,5 @@
 // Friction law of the quarter-car body's linear bearings (seed 000 section 3
-// and appendix B, with the slips resolved in shared/rig-parameters.md 1.3-1.4).
+// and appendix B, with the slips resolved in docs/rig-models.md 1.5.3-1.5.4).
 // Pure functions: the stick/slip bookkeeping lives in the plant, which knows
 // the sub-step boundaries where the mode may change.
 #pragma once

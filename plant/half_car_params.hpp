@@ -1,10 +1,10 @@
 // Parameters of the 4-DOF half vehicle of seed paper 001, in SI. Defaults are
-// the pitch-plane set of shared/rig-parameters.md section 3; roll_plane()
-// gives that section's roll-plane set. The paper's Table 1 mixes a full car
+// the pitch-plane set of docs/rig-models.md 3.3; roll_plane() gives that
+// section's roll-plane set. The paper's Table 1 mixes a full car
 // (M = 2160 kg, I_y = 4140, I_x = 946 kg m^2, four unsprung masses) with the
-// half-car equations; section 3 halves the full car and picks the springs
-// and dampers inside Table 2's ranges. The source of each value is noted
-// beside it.
+// half-car equations; the set halves the full car and picks the springs
+// and dampers inside Table 2's ranges (docs/rig-models.md 3.4.1). The
+// source of each value is noted beside it.
 //
 // Geometry and signs (both planes, one model):
 //   wheel 1 sits at lever arm l1 > 0 from the centre of gravity, wheel 2 at
@@ -27,7 +27,7 @@ struct HalfCarParams {
   HalfCarPlane plane = HalfCarPlane::kPitch;
 
   // Body.
-  double mass_body = 1080.0;     // m_s [kg]: half of Table 1's M = 2160 kg (rig-parameters.md 3)
+  double mass_body = 1080.0;     // m_s [kg]: half of Table 1's M = 2160 kg (docs/rig-models.md 3.4.1)
   double inertia_body = 2070.0;  // [kg m^2]: pitch, half of Table 1's I_y = 4140 (roll: I_x/2 = 473)
   double dist_front = 1.524;     // a [m], Table 1 (pitch plane)
   double dist_rear = 1.156;      // b [m], Table 1 (pitch plane)
@@ -36,17 +36,17 @@ struct HalfCarParams {
   // Corners: 1 = front (pitch) or right (roll), 2 = rear or left.
   double mass_unsprung_1 = 85.0;    // [kg] Table 1 M1, M3 (front)
   double mass_unsprung_2 = 60.0;    // [kg] Table 1 M2, M4 (rear)
-  double spring_1 = 80000.0;        // [N/m] Table 2 K1, K3 range 75-100 kN/m: rig-parameters.md 3
-  double spring_2 = 45000.0;        // [N/m] Table 2 K2, K4 range 32-70 kN/m: rig-parameters.md 3
-  double damper_1 = 1500.0;         // [N s/m] Table 2 C1, C3 range 875-3000: rig-parameters.md 3
-  double damper_2 = 1500.0;         // [N s/m] Table 2 C2, C4 range 875-3000: rig-parameters.md 3
+  double spring_1 = 80000.0;        // [N/m] Table 2 K1, K3 range 75-100 kN/m: docs/rig-models.md 3.3
+  double spring_2 = 45000.0;        // [N/m] Table 2 K2, K4 range 32-70 kN/m: docs/rig-models.md 3.3
+  double damper_1 = 1500.0;         // [N s/m] Table 2 C1, C3 range 875-3000: docs/rig-models.md 3.3
+  double damper_2 = 1500.0;         // [N s/m] Table 2 C2, C4 range 875-3000: docs/rig-models.md 3.3
   double tyre_stiffness_1 = 200000.0;  // K_u [N/m] Table 1 Kt
   double tyre_stiffness_2 = 200000.0;  // [N/m] Table 1 Kt
   double tyre_damping_1 = 0.0;      // [N s/m] the paper's tyre is a pure spring
   double tyre_damping_2 = 0.0;      // [N s/m]
 
   // Optional effects (nominal off), for the diagnosis causes of
-  // shared/spec/measured-data.md. The linear model of eq. 5 ignores them.
+  // docs/run-files.md 2.5. The linear model of eq. 5 ignores them.
   double damper_rebound_factor = 1.0;  // rebound (extension) damping / compression damping; 1 = linear damper
   double actuator_time_constant = 0.0; // [s] first-order lag of the active force behind its command; 0 = ideal
   // [s] a second, faster lag ahead of the first (the servo-valve spool
@@ -68,7 +68,7 @@ struct HalfCarParams {
   // to the ground. The gravity moment m_s g h_roll phi of the rolled body
   // is not in the paper's eq. 8 and is left out.
   double curve_radius = 0.0;      // R [m]; 0 = straight road
-  double roll_arm = 0.5;          // h_roll [m], rig-parameters.md 3 ("roll-centre height")
+  double roll_arm = 0.5;          // h_roll [m], docs/rig-models.md 3.3 ("roll-centre height")
   double curve_start_time = 0.0;  // [s] entry into the curve
   double curve_ramp_time = 0.0;   // [s] lateral acceleration ramps in linearly (a clothoid); 0 = step
 
@@ -81,7 +81,7 @@ struct HalfCarParams {
   // limit of the ~10 Hz wheel hop.
   int substeps = 10;
 
-  // rig-parameters.md 3 roll plane: body 1080 kg, roll inertia 473 kg m^2
+  // docs/rig-models.md 3.3 roll plane: body 1080 kg, roll inertia 473 kg m^2
   // (Table 1's I_x = 946 halved), track 1.45 m, 85 kg unsprung each side,
   // 80 kN/m springs, 1500 N s/m dampers, roll arm 0.5 m, 200 kN/m tyres;
   // curve radius 100 m (chosen: 4 m/s^2 lateral at 20 m/s, a brisk ordinary

@@ -1,5 +1,5 @@
 // Parameters of the flexible-bladder rotary pneumatic servo of seed paper 002
-// (Tillett et al.), in SI. Defaults are shared/rig-parameters.md section 2,
+// (Tillett et al.), in SI. Defaults are docs/rig-models.md section 2,
 // which resolves the paper's unit slips; reasons are noted beside each value
 // that was derived or chosen.
 #pragma once

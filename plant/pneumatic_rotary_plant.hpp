@@ -1,8 +1,8 @@
 // Nominal model of the flexible-bladder rotary pneumatic servo of seed 002:
 // solenoid spool valve with dither, Shearer-linearised valve flows and
 // chambers in the time domain, inertial load with bladder hysteresis, Coulomb
-// brake and end stops. Equations and parameters: shared/rig-parameters.md
-// section 2 "Equations (nominal)".
+// brake and end stops. Equations and parameters: docs/rig-models.md
+// section 2 (2.2 "Equations", 2.5 "Parameters").
 //
 //   U_v = u + valve_null_offset + A_d sin(2 pi f_d t)       (dither if enabled)
 //   x   = sat(k_sol U_v, +-spool_limit)

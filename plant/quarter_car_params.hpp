@@ -1,5 +1,5 @@
 // Parameters of the quarter-car road-simulator rig of seed paper 000, in SI.
-// Defaults are the nominal set of shared/rig-parameters.md section 1, where
+// Defaults are the nominal set of docs/rig-models.md section 1, where
 // the seed's unit slips are resolved; the reasons are repeated next to each
 // value that was derived or chosen rather than taken from the paper.
 #pragma once
@@ -38,7 +38,7 @@ struct QuarterCarHiddenEffects {
   // Spool overlap: no metering until |x_s| exceeds it, a sharp dead band.
   double valve_overlap = 0.0;             // [fraction of rated spool travel]
   // Entrained air: effective bulk modulus of oil with free air, Simscape
-  // isothermal-liquid mixture law (shared/diagnosis-notes.md 2.4), n = 1.
+  // isothermal-liquid mixture law (docs/rig-models.md 1.6), n = 1.
   double air_fraction = 0.0;              // alpha at atmospheric pressure [1]
   // Damper with different rebound and compression coefficients (piecewise
   // linear in the relative velocity). 1, 1: the nominal symmetric damper.
@@ -56,7 +56,7 @@ struct QuarterCarParams {
   double bulk_modulus = 1.43e9;    // beta [Pa]
   double supply_pressure = 200e5;  // Ps [Pa gauge]; tank is 0
   // Kv [m^3/s/sqrt(Pa)] per unit command: 20 l/min at 35 bar per metering edge.
-  // The paper's 0.99e-4 m^3/s/mA gives absurd flows (shared/rig-parameters.md 1.1).
+  // The paper's 0.99e-4 m^3/s/mA gives absurd flows (docs/rig-models.md 1.5.1).
   double valve_flow_gain = 1.782e-7;
   double valve_time_constant = 0.004;  // tau_r [s], chosen: the paper gives none
   double laminar_pressure = 2e5;       // [Pa] below it the orifice law is linear, keeping dP/dt Lipschitz

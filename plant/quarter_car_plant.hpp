@@ -1,7 +1,7 @@
 // Nominal model of the quarter-car road-simulator rig of seed 000: servovalve,
 // single-rod actuator with cross-port leakage, tyre plate, wheel and body on
 // linear bearings with stick-slip friction. Equations and parameters are
-// shared/rig-parameters.md section 1 "Equations (nominal)".
+// docs/rig-models.md 1.2 "Equations" and 1.3 "Body-bearing friction".
 #pragma once
 
 #include <algorithm>

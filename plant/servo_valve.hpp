@@ -1,5 +1,5 @@
 // Flow law of the quarter-car rig's four-way servovalve (seed 000 eqs. 2-5,
-// flow gain and laminar branch per shared/rig-parameters.md 1.1).
+// flow gain and laminar branch per docs/rig-models.md 1.5.1).
 #pragma once
 
 namespace rigctl {

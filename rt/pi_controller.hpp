@@ -1,5 +1,5 @@
 // The PI law of seed 000 (eq. 9-10), written as a true discrete integrator
-// (the paper's u = Kp e + Ki e Ts has none; shared/rig-parameters.md 1.5):
+// (the paper's u = Kp e + Ki e Ts has none; docs/rig-models.md 1.5.5):
 //   e_k = r_k - y_k,  I_k = I_{k-1} + Ki Ts e_k,  u_k = sat(Kp e_k + I_k)
 #pragma once
 

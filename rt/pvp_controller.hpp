@@ -1,5 +1,5 @@
 // The pneumatic servo's controller of seed 002, eq. 1 with the sign
-// convention of shared/rig-parameters.md section 2.1 (every term negative
+// convention of docs/rig-models.md 2.6.1 (every term negative
 // feedback, valve opening +U drives theta up):
 //   U = Ke (theta_d - theta) - Kp dp - Kv omega,   saturated at +-U_max
 // With transient pressure feedback (eq. 18) the pressure term acts on the

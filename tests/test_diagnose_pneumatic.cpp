@@ -6,7 +6,7 @@
 // generator itself (apply() on the same config), so no physical size is
 // repeated here.
 //
-// Strength tolerances follow shared/diagnosis-notes.md 4.9: +-10 % at the
+// Strength tolerances follow docs/diagnosis.md 7: +-10 % at the
 // strong level, +-20 % at the weak one, on the departure of the effect's
 // size from its null. Where the fitted and the generating formulas differ,
 // the compared quantity is the physically equivalent one:

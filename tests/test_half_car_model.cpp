@@ -225,7 +225,7 @@ TEST(HalfCarModel, OptionalActuatorLagAndDamperAsymmetry) {
 // ----------------------------------------------------------- eigenfrequencies
 
 TEST(HalfCarModel, EigenfrequenciesMatchTheHandCalculation) {
-  const HalfCarParams p;  // rig-parameters.md 3, pitch plane
+  const HalfCarParams p;  // docs/rig-models.md 3.3, pitch plane
   const HalfCarModel m = HalfCarModel::build(p);
   const auto modes = m.modes();
   ASSERT_EQ(modes.size(), 4u);

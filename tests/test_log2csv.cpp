@@ -1,5 +1,5 @@
 // log_to_csv: a log written by TelemetryPublisher becomes a run file of
-// shared/spec/measured-data.md with the right metadata, header and values;
+// docs/run-files.md with the right metadata, header and values;
 // ticks missing a message are skipped and counted; bad inputs throw naming
 // the file and leave no output behind.
 #include <gtest/gtest.h>

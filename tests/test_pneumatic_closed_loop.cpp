@@ -377,7 +377,7 @@ TEST(PneumaticClosedLoop, VelocityFeedbackAddsOnlyLimitedDamping) {
   EXPECT_GE(d.m.reversals, 10);
 }
 
-// ------------------- rig-parameters.md table: Ke 7.4 with the light arm
+// ------------------- docs/rig-models.md 2.7 table: Ke 7.4 with the light arm
 
 TEST(PneumaticClosedLoop, HighGainLightArmIsUnstableWithoutHysteresisAndSettlesWithIt) {
   const Case bare{"Ke 7.4, I 0.4, none", 7.4, 0, 0, false, 0.4, 0.0, 0.0};

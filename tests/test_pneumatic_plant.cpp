@@ -1,5 +1,5 @@
 // Open-loop checks of the rotary pneumatic plant against hand calculations
-// from shared/rig-parameters.md section 2 and seed 002 eqs. 2-17, not against
+// from docs/rig-models.md section 2 and seed 002 eqs. 2-17, not against
 // numbers read back from the implementation.
 #include <gtest/gtest.h>
 
@@ -27,7 +27,7 @@ namespace sig = pneumatic_rotary_signal;
 constexpr double kDt = 0.0025;  // control period [s]
 constexpr double kPi = std::numbers::pi;
 
-// Hand values from the nominal parameters (rig-parameters.md section 2).
+// Hand values from the nominal parameters (docs/rig-models.md 2.5).
 constexpr double kGammaRT = 1.4 * 287.0 * 293.0;                  // gamma R T [J/kg]
 constexpr double kTau = 0.25e-3 / (kGammaRT * 4e-9);              // V / (gamma R T C2) = 0.531 s
 constexpr double kStiffness = 2.0 * 1.4 * 4.5e5 * 1.2e-4 * 1.2e-4 / 0.25e-3;  // 2 gamma Pq alpha^2 / V = 72.6 N m/rad
@@ -179,7 +179,7 @@ TEST(PneumaticChambers, BlockedLoadPressureRisesWithTimeConstantTau) {
   const double x = 0.161e-3 * u;
   const double p_ss = 1.5 * x / 4e-9;  // 1.21 bar
   std::printf("  tau = %.4f s, p_a -> %.0f Pa, dp -> %.0f Pa\n", kTau, p_ss, 2.0 * p_ss);
-  EXPECT_NEAR(kTau, 0.53, 0.005);  // rig-parameters.md "Behaviour to expect"
+  EXPECT_NEAR(kTau, 0.53, 0.005);  // docs/rig-models.md 2.7 "Behaviour to expect"
 
   run(plant, u, kTau, [](double, const PneumaticRotaryPlant&) {}, kTau / 200.0);
   EXPECT_NEAR(plant.state().time, kTau, 1e-12);

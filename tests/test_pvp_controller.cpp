@@ -1,5 +1,5 @@
 // The pneumatic servo's P + velocity + differential-pressure law (seed 002
-// eq. 1, signs of rig-parameters.md 2.1) and its transient-pressure variant.
+// eq. 1, signs of docs/rig-models.md 2.6.1) and its transient-pressure variant.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -106,7 +106,7 @@ TEST(QuarterCarStepTest, TracksTheFilteredStepsAndIntegralActionRemovesTheError)
   const StepRun& run = with_friction();
   double peak_error = 0.0;
   for (const auto& k : run.ticks) peak_error = std::max(peak_error, std::abs(k.x_ref - k.x_r));
-  // rig-parameters.md: peak error 6-7 mm during a 50 mm step.
+  // docs/rig-models.md 1.7: peak error 6-7 mm during a 50 mm step.
   std::printf("peak tracking error %.2f mm\n", peak_error * 1e3);
   EXPECT_GT(peak_error, 0.004);
   EXPECT_LT(peak_error, 0.009);

@@ -1,6 +1,6 @@
 // Physics checks of the quarter-car plant against hand calculations and the
 // conservation laws, not against numbers read back from the implementation.
-// Expected values come from shared/rig-parameters.md section 1.
+// Expected values come from docs/rig-models.md section 1.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -51,7 +51,7 @@ double suspension_force(const QuarterCarParams& p, const QuarterCarState& s) {
   return p.spring_stiffness * (s.x_w - s.x_b) + p.damper_damping * (s.v_w - s.v_b);
 }
 
-// Breakaway force written out from rig-parameters.md 1.4 and seed eq. 14,
+// Breakaway force written out from docs/rig-models.md 1.5.4 and seed eq. 14,
 // independently of plant/bearing_friction.cpp.
 double breakaway(const QuarterCarParams& p, const QuarterCarState& s) {
   const auto& f = p.bearing_friction;
@@ -129,7 +129,7 @@ TEST(QuarterCarStatics, LeakageBalancedRestMatchesHandCalculation) {
   const QuarterCarParams p;
   QuarterCarPlant plant(p);
   const QuarterCarState rest = plant.state();
-  // rig-parameters.md 1 "Behaviour to expect": 74.5 bar, 125.5 bar, u0 = -0.043.
+  // docs/rig-models.md 1.7 "Behaviour to expect": 74.5 bar, 125.5 bar, u0 = -0.043.
   EXPECT_NEAR(rest.p1, 74.5 * kBar, 0.1 * kBar);
   EXPECT_NEAR(rest.p2, 125.5 * kBar, 0.1 * kBar);
   const double u0 = QuarterCarPlant::rest_valve_offset(p);
@@ -375,7 +375,7 @@ double mean_speed(const QuarterCarParams& p, double u, double x_start, double t_
 }
 
 TEST(QuarterCarFlowLimit, FullCommandGivesRatedSpeeds) {
-  // rig-parameters.md 1: extend 0.372 m/s, retract 0.286 m/s. The spool
+  // docs/rig-models.md 1.7: extend 0.372 m/s, retract 0.286 m/s. The spool
   // settles within 0.1 s; stop well short of the end stops.
   QuarterCarParams p;
   p.leakage = false;  // the quoted speeds are the valve's flow limit alone
@@ -607,7 +607,7 @@ TEST(QuarterCarBearing, FrictionStopsTheBodyModeThatTheDamperBarelyDamps) {
   std::printf("  ring-down: p2p over 2-4 s %.3f mm without friction, %.3f mm with; ends held at %.1f N < %.1f N\n",
               off.p2p_late * 1e3, on.p2p_late * 1e3, on.final_force, on.final_limit);
 
-  // Without friction: the 1.75 Hz, 4.9 %-damped body mode of rig-parameters.md.
+  // Without friction: the 1.75 Hz, 4.9 %-damped body mode of docs/rig-models.md 1.7.
   ASSERT_GE(off.up_crossings.size(), 5u);
   const double period = (off.up_crossings.back() - off.up_crossings.front()) / (off.up_crossings.size() - 1);
   EXPECT_NEAR(1.0 / period, 1.75, 0.05);

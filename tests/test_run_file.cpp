@@ -1,4 +1,4 @@
-// Run-file reader (tools/run_file.*) against shared/spec/measured-data.md section 1.
+// Run-file reader (tools/run_file.*) against docs/run-files.md section 1.
 #include <gtest/gtest.h>
 
 #include <sstream>

@@ -1,4 +1,4 @@
-// `rigctl diagnose` (shared/spec/measured-data.md section 2).
+// `rigctl diagnose` (docs/run-files.md section 2).
 #pragma once
 
 #include <ostream>

@@ -57,7 +57,7 @@ std::string fmt(double v, int prec = 4) {
 }
 
 // Share of the residual's variance explained by its mean in quantile bins of
-// the indicator (conditional statistics, diagnosis notes 4.3).
+// the indicator (conditional statistics, docs/diagnosis.md 3).
 double binned_r2(const std::vector<double>& ind, const std::vector<double>& e, std::size_t b, std::size_t end) {
   if (ind.size() < end || end <= b + 20) return 0.0;
   std::vector<std::size_t> idx(end - b);

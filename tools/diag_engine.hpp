@@ -1,10 +1,10 @@
-// Model-discrepancy diagnosis engine (shared/diagnosis-notes.md section 4):
+// Model-discrepancy diagnosis engine (docs/diagnosis.md sections 4-5):
 // baseline output-error fit on the estimation part, screening of every
 // candidate effect of the rig (short refits, with a start grid for
 // non-convex scalars), full refit of the best few, acceptance on held-out
 // gain + parameter significance + parsimony (BIC with N_eff), greedy
 // addition, a backward check, and `none` when nothing earns its place.
-// Output: the JSON of shared/spec/measured-data.md section 2 and an HTML report.
+// Output: the JSON of docs/run-files.md 2.3 and an HTML report.
 #pragma once
 
 #include <map>

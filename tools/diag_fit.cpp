@@ -95,7 +95,7 @@ class SimCost : public ceres::CostFunction {
 }  // namespace
 
 // Effective sample count of a coloured residual: N / (1 + 2 sum rho_k), the
-// sum running until the autocorrelation first drops below 0.05 (diagnosis notes 6).
+// sum running until the autocorrelation first drops below 0.05 (docs/diagnosis.md 5).
 double effective_fraction(const std::vector<double>& r) {
   const std::size_t n = r.size();
   if (n < 10) return 1.0;

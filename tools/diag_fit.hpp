@@ -33,7 +33,7 @@ struct FitResult {
 // by the residual variance and inflated for coloured residuals (N / N_eff).
 FitResult fit_output_error(const FitProblem& problem, bool with_covariance);
 
-// N_eff / N of a coloured residual series (diagnosis notes 6).
+// N_eff / N of a coloured residual series (docs/diagnosis.md 5, "Why N_eff").
 double effective_fraction(const std::vector<double>& r);
 
 // Weighted residuals of a simulation on the mask (for costs outside Ceres).

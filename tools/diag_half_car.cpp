@@ -1,4 +1,4 @@
-// Diagnosis sub-model of the half car (seed 001, shared/rig-parameters.md 3):
+// Diagnosis sub-model of the half car (seed 001, docs/rig-models.md 3):
 // open-loop replay of the measured roads z_r1, z_r2 and the actuator force
 // commands f_1, f_2 through the linear 4-DOF model of plant/half_car_model.hpp
 // (centre-of-gravity coordinates), outputs z_s, phi, z_u1, z_u2.
@@ -127,7 +127,7 @@ class HalfCarDiagModel : public RigModel {
   }
   std::vector<EffectSpec> effects() const override {
     // Start grids: the lag and the delay are non-convex scalars; a second start
-    // a few times larger covers strong effects (diagnosis notes 4.5).
+    // a few times larger covers strong effects (docs/diagnosis.md 4).
     return {
         {"actuator_lag", {P("tau_a", "s", 0.005, 0.0, 0.2, 0.01, 0.0, true, {0.025})},
          "the active force follows its command through a first-order lag tau_a"},

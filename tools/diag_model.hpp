@@ -6,7 +6,7 @@
 // effect's parameters) and writes the free-run outputs. Each effect's
 // parameters have null values at which the effect vanishes, so the baseline
 // is the full vector with every effect at its null, and a candidate is the
-// baseline with that effect's parameters freed (shared/diagnosis-notes.md 4.2).
+// baseline with that effect's parameters freed (docs/diagnosis.md 1).
 #pragma once
 
 #include <memory>

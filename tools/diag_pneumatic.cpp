@@ -1,5 +1,5 @@
 // Diagnosis sub-model of the flexible-bladder rotary pneumatic servo (seed 002,
-// shared/rig-parameters.md section 2): closed-loop replay of the measured
+// docs/rig-models.md section 2): closed-loop replay of the measured
 // demand theta_d through the rig's own P + velocity + differential-pressure
 // controller (rt/pvp_controller, gains from the config) and a reduced plant:
 //
@@ -29,7 +29,7 @@
 // DAC-generated dither are; `# dither_phase_rad: ...` in the run file's
 // metadata sets another phase.
 //
-// Candidate effects (diagnosis notes 4.2), each null gives the baseline:
+// Candidate effects (docs/diagnosis.md 2.2), each null gives the baseline:
 //  * bladder_hysteresis: the seed's trapezoid as a smooth two-part element, a
 //    step part h_s tanh(omega/eps) plus a Dahl element T_e z with
 //    dz/dtheta = (1 - sign(omega) z) / theta_r: after a reversal the torque

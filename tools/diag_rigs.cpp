@@ -1,5 +1,5 @@
 // Sub-models of the diagnosis, one per rig kind, with a candidate effect for
-// every cause id of shared/spec/measured-data.md (stubs are marked).
+// every cause id of docs/run-files.md 2.5 (stubs are marked).
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>

@@ -8,8 +8,8 @@
 // phase), the simulated driver's cubic delay line (linear interpolation in
 // the diagnosis).
 //
-// The dither stays on: it is part of the rig (shared/diagnosis-notes.md 4.2,
-// "dither is part of the model, not a cause") and the diagnosis replays it.
+// The dither stays on: it is part of the rig (docs/diagnosis.md 2.2:
+// the dither is part of the model, not a cause) and the diagnosis replays it.
 //
 // Levels: 1 is strong, weak_level() = 0.35 of each physical size below.
 #include <stdexcept>

@@ -1,4 +1,4 @@
-// LCM log -> run-file CSV (shared/spec/measured-data.md). Two passes over the
+// LCM log -> run-file CSV (docs/run-files.md). Two passes over the
 // log: the first finds the layout and the sample rate (the metadata lines come
 // before the data), the second joins SAMPLE and COMMAND by tick and writes
 // rows, holding only a short window of ticks in memory.

@@ -1,5 +1,5 @@
 // Converts an LCM telemetry log (written by TelemetryPublisher or lcm-logger)
-// into a run file of shared/spec/measured-data.md, so a recorded run can go
+// into a run file of docs/run-files.md, so a recorded run can go
 // straight into `rigctl diagnose`.
 #pragma once
 

@@ -59,7 +59,7 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--fault", run_fault_texts, "Inject a fault in the simulated driver, KIND@TIME[:ARG...] (stuck, rail, noise, nan, offset, overrun, supply, burst; SAFETY.md); repeatable");
 
   std::string log_in, csv_out, prefix = "RIGCTL_";
-  auto* l2c = app.add_subcommand("log2csv", "Convert a run's LCM log into a CSV run file (shared/spec/measured-data.md)");
+  auto* l2c = app.add_subcommand("log2csv", "Convert a run's LCM log into a CSV run file (docs/run-files.md)");
   l2c->add_option("log", log_in, "LCM log written by rigctl run")->required();
   l2c->add_option("csv", csv_out, "CSV file to write")->required();
   l2c->add_option("--channel-prefix", prefix, "Telemetry channel prefix used by the run");
@@ -100,7 +100,7 @@ int main(int argc, char** argv) {
   bench_cmd->add_option("--section", bench.sections, "Run only this section; repeatable")->check(CLI::IsMember(rigctl::bench_section_names()));
 
   rigctl::DiagnoseCommandOptions diag;
-  auto* diag_cmd = app.add_subcommand("diagnose", "Model-discrepancy diagnosis of a run file (shared/spec/measured-data.md)");
+  auto* diag_cmd = app.add_subcommand("diagnose", "Model-discrepancy diagnosis of a run file (docs/run-files.md, docs/diagnosis.md)");
   diag_cmd->add_option("--rig", diag.rig, "Rig kind: quarter_car, pneumatic_rotary, half_car, linear_axis, damper")->required();
   diag_cmd->add_option("--data", diag.data_path, "Run file (CSV)")->required();
   diag_cmd->add_option("--config", diag.config_path, "Rig config (default: nominal parameters)");

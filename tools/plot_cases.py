@@ -3,7 +3,7 @@
 
     tools/plot_cases.py --out FIG.png --title TITLE PANEL:LABEL=RUN.csv [...]
 
-Each argument puts the run file RUN.csv (shared/spec/measured-data.md) into
+Each argument puts the run file RUN.csv (docs/run-files.md) into
 panel PANEL with legend LABEL; panels are laid out side by side. The demand
 and response columns follow the rig in the file's `# rig:` line
 (pneumatic_rotary: theta_d/theta; quarter_car: x_ref/x_r).

@@ -3,7 +3,7 @@
 
     tools/plot_run.py RUN.csv [--out DIR] [--step-window T0 T1]
 
-Reads a run file of shared/spec/measured-data.md (as written by
+Reads a run file of docs/run-files.md (as written by
 `rigctl run --csv` or `rigctl log2csv`) and writes PNGs into DIR:
   fig04_road.png      demand x_ref and road actuator x_r        (paper Fig. 4)
   fig05_control.png   tracking error and valve command u         (Fig. 5)

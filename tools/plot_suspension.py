@@ -4,7 +4,7 @@
     tools/plot_suspension.py DIR [--out FIGDIR] [--window T0 T1] [--zoom T0 T1] [--title TEXT]
 
 DIR holds the run files of `rigctl compare` (passive.csv, fuzzy.csv,
-skyhook.csv, lqr.csv; shared/spec/measured-data.md, half_car columns) and
+skyhook.csv, lqr.csv; docs/run-files.md, half_car columns) and
 its metrics.json. One PNG per figure group goes to FIGDIR (default DIR);
 with --zoom each figure gets a second column showing that interval:
 

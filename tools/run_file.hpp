@@ -1,4 +1,4 @@
-// Reader of run files, shared/spec/measured-data.md section 1: optional
+// Reader of run files, docs/run-files.md section 1: optional
 // `# key: value` metadata lines, one header row, one row per sample, `t`
 // first and strictly increasing, SI columns.
 //

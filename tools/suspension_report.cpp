@@ -256,7 +256,7 @@ void explain(const CompareResult& r, const HalfCarParams& p, double force_limit,
     out << "\n";
   }
   out << "* The vehicle: Table 1 mixes a full car (M = 2160 kg, I_y = 4140, I_x = 946 kg m^2) with half-car "
-         "equations; we simulate half of it (rig-parameters.md 3) with springs and dampers inside Table 2. The "
+         "equations; we simulate half of it (docs/rig-models.md 3.4.1) with springs and dampers inside Table 2. The "
          "paper's LQR figures (Wk RMS 0.2834 -> 0.0492 m/s^2) are quoted for its own LQR design, whose weights "
          "it does not give";
   if (pas.wk_rms_acc > 1e-6) {

@@ -46,7 +46,7 @@ double half_car_disturbance_start(const HalfCarParams& p);
 SuspensionRecording run_half_car(const RigConfig& config, const std::string& controller_type, double duration_s,
                                  bool keep_rows = true);
 
-// Writes a recording as a run file (shared/spec/measured-data.md): metadata
+// Writes a recording as a run file (docs/run-files.md): metadata
 // lines, then t, the setpoint, the outputs, every plant signal.
 void write_recording_csv(const SuspensionRecording& rec, const std::string& path, const std::string& note);
 

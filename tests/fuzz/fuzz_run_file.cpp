@@ -1,4 +1,4 @@
-// Fuzzes the run-file (CSV) reader of the measured-data contract,
+// Fuzzes the run-file (CSV) reader of docs/run-files.md,
 // tools/run_file.cpp. The first input byte picks the options (rig kind's
 // columns or keep-all, drop_bad_rows, min_rows); the rest is the file.
 // RunFileError is the reader's documented answer; anything else is a bug.

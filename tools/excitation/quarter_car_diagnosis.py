@@ -2,7 +2,7 @@
 """Writes config/quarter_car_diagnosis_demand.csv: the road-actuator demand of
 the quarter car's `diagnosis` case (rigctl make-run, diagnosis tests).
 
-Each part is there to make one family of effects visible (shared/diagnosis-notes.md 4.2):
+Each part is there to make one family of effects visible (docs/diagnosis.md 6):
   * lead-in from home to mid-stroke (0.08 m), slow: start without a jump;
   * steps of several sizes both ways: the hydraulics and the PI loop in full
     (valve saturation, pressure transients: entrained air, leakage);
