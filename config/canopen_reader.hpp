@@ -1,5 +1,5 @@
 // Reader of the `canopen:` config section (the CANopen servovalve client,
-// drivers/canopen_valve.hpp). Strict like every reader: unknown keys, wrong
+// drivers/canopen/canopen_valve.hpp). Strict like every reader: unknown keys, wrong
 // types, out-of-range values and inconsistent combinations stop the program
 // with `file:line: canopen.key: reason`.
 //
@@ -34,7 +34,7 @@
 #pragma once
 
 #include "config/config_reader.hpp"
-#include "drivers/canopen_valve_config.hpp"
+#include "drivers/canopen/canopen_valve_config.hpp"
 
 namespace rigctl {
 

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "drivers/modbus_write_plan.hpp"
+#include "drivers/modbus/modbus_write_plan.hpp"
 #include "rt/sample.hpp"
 
 namespace rigctl {

@@ -39,7 +39,7 @@
 #pragma once
 
 #include "config/config_reader.hpp"
-#include "drivers/modbus_daq_config.hpp"
+#include "drivers/modbus/modbus_daq_config.hpp"
 
 namespace rigctl {
 

@@ -3,9 +3,9 @@
 #pragma once
 
 #include "config/config_reader.hpp"
-#include "plant/half_car_params.hpp"
-#include "plant/pneumatic_rotary_params.hpp"
-#include "plant/quarter_car_params.hpp"
+#include "plant/half_car/half_car_params.hpp"
+#include "plant/pneumatic_rotary/pneumatic_rotary_params.hpp"
+#include "plant/quarter_car/quarter_car_params.hpp"
 
 namespace rigctl {
 

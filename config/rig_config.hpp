@@ -11,18 +11,18 @@
 
 #include "config/operator_config.hpp"
 #include "config/suspension_controller_reader.hpp"
-#include "drivers/canopen_valve_config.hpp"
-#include "drivers/modbus_daq_config.hpp"
-#include "drivers/sensor_model.hpp"
-#include "plant/half_car_params.hpp"
-#include "plant/pneumatic_rotary_params.hpp"
-#include "plant/quarter_car_params.hpp"
-#include "rt/limit_action.hpp"
-#include "rt/pi_controller.hpp"
-#include "rt/pvp_controller.hpp"
+#include "drivers/canopen/canopen_valve_config.hpp"
+#include "drivers/modbus/modbus_daq_config.hpp"
+#include "drivers/sim/sensor_model.hpp"
+#include "plant/half_car/half_car_params.hpp"
+#include "plant/pneumatic_rotary/pneumatic_rotary_params.hpp"
+#include "plant/quarter_car/quarter_car_params.hpp"
+#include "rt/safety/limit_action.hpp"
+#include "rt/control/pi_controller.hpp"
+#include "rt/control/pvp_controller.hpp"
 #include "rt/realtime.hpp"
 #include "rt/timing_stats.hpp"
-#include "drivers/fault_spec.hpp"
+#include "drivers/sim/fault_spec.hpp"
 
 namespace rigctl {
 
@@ -77,7 +77,7 @@ struct LimitConfig {
 // The `safety:` section (config/safety_config.cpp): the state machine's
 // ramps and staging, the action of the `limits:` ranges, and the limit
 // detectors. Channel names are resolved when the rig is assembled
-// (tools/rig_assembly.cpp), with errors naming safety.detectors.NAME.
+// (tools/run/rig_assembly.cpp), with errors naming safety.detectors.NAME.
 struct DetectorConfig {
   std::string name;     // key under safety.detectors
   std::string type;     // range | rate | tracking_error | valve_saturation | sample_age | overruns | open_circuit | stuck
@@ -126,7 +126,7 @@ struct RigConfig {
   std::vector<LimitConfig> limits;
   SafetyConfig safety;  // `safety:`; optional, defaults as SafetyConfig{}
   OperatorConfig operator_commands;  // `operator:`; optional (config/operator_config.hpp)
-  std::vector<FaultSpec> faults;     // `faults:`; optional list of KIND@TIME[:ARG...] (drivers/sim_faults.hpp)
+  std::vector<FaultSpec> faults;     // `faults:`; optional list of KIND@TIME[:ARG...] (drivers/sim/sim_faults.hpp)
   QuarterCarParams quarter_car;          // rig quarter_car
   PneumaticRotaryParams pneumatic_rotary;  // rig pneumatic_rotary
   HalfCarParams half_car;                  // rig half_car

@@ -4,7 +4,7 @@
 // every key required, errors name file, line and key.
 //
 // The fuzzy controller is read as a general Mamdani engine
-// (rt/fuzzy_engine.hpp): two inputs and one output, each with its universe,
+// (rt/control/fuzzy_engine.hpp): two inputs and one output, each with its universe,
 // scale and named membership functions, and the rule base as a table.
 //
 //   fuzzy:
@@ -34,10 +34,10 @@
 #include <vector>
 
 #include "config/config_reader.hpp"
-#include "rt/fuzzy_engine.hpp"
-#include "rt/fuzzy_suspension_controller.hpp"
-#include "rt/lqr_controller.hpp"
-#include "rt/suspension_controller.hpp"
+#include "rt/control/fuzzy_engine.hpp"
+#include "rt/control/fuzzy_suspension_controller.hpp"
+#include "rt/control/lqr_controller.hpp"
+#include "rt/control/suspension_controller.hpp"
 
 namespace rigctl {
 

@@ -8,9 +8,9 @@
 #include <memory>
 #include <optional>
 
-#include "drivers/canopen_valve.hpp"
-#include "drivers/driver.hpp"
-#include "drivers/modbus_daq.hpp"
+#include "drivers/canopen/canopen_valve.hpp"
+#include "rt/driver.hpp"
+#include "drivers/modbus/modbus_daq.hpp"
 
 namespace rigctl {
 

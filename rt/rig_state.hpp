@@ -1,6 +1,6 @@
 // Rig states published with every sample: the coarse run state (what a run
 // log reader needs: did it start, run, stop or fault) and the full safety
-// state of rt/rig_state_machine.hpp (what a test engineer sees on the HMI).
+// state of rt/safety/rig_state_machine.hpp (what a test engineer sees on the HMI).
 #pragma once
 
 #include <cstddef>
@@ -28,7 +28,7 @@ constexpr std::string_view to_string(RigState s) {
   return "unknown";
 }
 
-// The safety state machine's states (rt/rig_state_machine.hpp has the
+// The safety state machine's states (rt/safety/rig_state_machine.hpp has the
 // transition table). Order is fixed: tables and tests index by it.
 enum class SafetyState : uint8_t {
   kOff,             // hydraulics off, valve at its safe command

@@ -38,11 +38,11 @@ enum class EventCode : uint8_t {
   kInputInvalid,     // driver flagged input `channel` invalid (NaN, stale)
   kDriverReadFailed,  // no usable sample, or the driver could not deliver the commands
   kQueueOverflow,    // telemetry records were dropped (value = count)
-  // Safety core (rt/rig_state_machine.hpp, rt/limit_detectors.hpp). `detail`
+  // Safety core (rt/safety/rig_state_machine.hpp, rt/safety/limit_detectors.hpp). `detail`
   // carries the command kind, rejection reason or limit action.
   kStateChanged,      // value = the previous SafetyState, detail = the new one
   kCommandAccepted,   // detail = OperatorCommandKind, value = its value
-  kCommandRejected,   // detail = Rejection (rt/rig_state_machine.hpp), channel = OperatorCommandKind
+  kCommandRejected,   // detail = Rejection (rt/safety/rig_state_machine.hpp), channel = OperatorCommandKind
   kRateLimit,         // input `channel` changed faster than its limit (value = rate)
   kTrackingError,     // |demand - feedback| of input `channel` over its limit (value = error)
   kValveSaturated,    // output `channel` at its saturation level too long (value = command)
@@ -87,7 +87,7 @@ struct Event {
   int16_t channel = -1;  // input index the event is about, -1 when none
   double value = 0.0;
   uint8_t detail = 0;    // code-specific (see EventCode)
-  uint8_t action = 0;    // LimitAction of a limit trip (rt/limit_action.hpp), 0 otherwise
+  uint8_t action = 0;    // LimitAction of a limit trip (rt/safety/limit_action.hpp), 0 otherwise
 };
 
 struct TelemetryRecord {

@@ -3,9 +3,9 @@
 # of seed paper 000 in real time, then write its CSV and plots.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-"$root/tools/setup.sh" --plots
+"$root/tools/scripts/setup.sh" --plots
 cd "$root"
 mkdir -p runs
 stamp=$(date +%Y%m%d-%H%M%S)
 build/tools/rigctl run config/quarter_car.yaml --log "runs/quarter_car-$stamp.lcm" --csv "runs/quarter_car-$stamp.csv" "$@"
-/usr/bin/python3 tools/plot_run.py "runs/quarter_car-$stamp.csv" --out "runs/quarter_car-$stamp-plots"
+/usr/bin/python3 tools/plots/plot_run.py "runs/quarter_car-$stamp.csv" --out "runs/quarter_car-$stamp-plots"

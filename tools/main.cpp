@@ -7,15 +7,15 @@
 #include <iostream>
 
 #include "config/config_reader.hpp"
-#include "tools/bench_command.hpp"
-#include "tools/cmd_command.hpp"
-#include "tools/diag_command.hpp"
-#include "tools/hidden_effects.hpp"
-#include "tools/log2csv.hpp"
-#include "tools/optimize_command.hpp"
-#include "tools/rig_sim.hpp"
-#include "tools/run_command.hpp"
-#include "tools/suspension_report.hpp"
+#include "tools/bench/bench_command.hpp"
+#include "tools/cmd/cmd_command.hpp"
+#include "tools/diagnosis/diagnose_command.hpp"
+#include "tools/hidden_effects/make_run.hpp"
+#include "tools/runfile/log2csv.hpp"
+#include "tools/suspension/optimize_command.hpp"
+#include "tools/rig_sim/rig_sim.hpp"
+#include "tools/run/run_command.hpp"
+#include "tools/suspension/compare_command.hpp"
 
 namespace {
 
@@ -122,7 +122,7 @@ int main(int argc, char** argv) {
   make_cmd->add_option("--out", make.out_csv, "Run file to write (CSV)")->required();
   make_cmd->add_option("--truth", make.truth_json, "Write what was hidden (JSON)");
 
-  // Authenticated operator commands (issue 7; tools/cmd_command.hpp).
+  // Authenticated operator commands (issue 7; tools/cmd/cmd_command.hpp).
   rigctl::CmdOptions opcmd;
   auto* opcmd_cmd = app.add_subcommand("cmd", "Send an authenticated operator command to a rig and wait for its acknowledgement (docs/operator-commands.md)");
   opcmd_cmd->add_option("command", opcmd.command, "arm|start|hold|resume|stop|reset|hydraulics-low|hydraulics-high|hydraulics-off|setpoint")->required();

@@ -15,7 +15,7 @@ case "${1:-}" in
   *) echo "test.sh: unknown option $1 (use --soak N)" >&2; exit 2 ;;
 esac
 
-"$root/tools/setup.sh"
+"$root/tools/scripts/setup.sh"
 cd "$root/build"
 jobs=$(nproc)
 
@@ -38,7 +38,7 @@ if [ "$soak" -eq 0 ]; then
   failed=()
   ctest --output-on-failure -j"$jobs" --timeout 900 || failed+=(ctest)
   check_tree || failed+=("source tree check")
-  "$root/tools/fuzz.sh" 10 || failed+=(fuzzing)  # libFuzzer harnesses (tests/fuzz/README.md): corpus replay plus 10 s per target
+  "$root/tools/scripts/fuzz.sh" 10 || failed+=(fuzzing)  # libFuzzer harnesses (tests/fuzz/README.md): corpus replay plus 10 s per target
   if [ ${#failed[@]} -gt 0 ]; then
     echo "test.sh: failed: ${failed[*]}" >&2
     exit 1
@@ -48,7 +48,7 @@ fi
 
 # Soak: the suite under a CPU hog at normal priority on every core (Debian's
 # stress-ng), as on a busy CI machine with a build beside the tests.
-"$root/tools/install_packages.sh" soak stress-ng
+"$root/tools/scripts/install_packages.sh" soak stress-ng
 hog_pid=""
 stop_hog() { if [ -n "$hog_pid" ]; then kill "$hog_pid" 2>/dev/null || true; wait "$hog_pid" 2>/dev/null || true; hog_pid=""; fi; }
 trap stop_hog EXIT

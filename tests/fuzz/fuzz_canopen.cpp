@@ -24,14 +24,14 @@
 
 #include "tests/fuzz/fuzz_input.hpp"
 
-#include "drivers/canopen/can_frame.hpp"
-#include "drivers/canopen/cia408.hpp"
-#include "drivers/canopen/cob_id.hpp"
-#include "drivers/canopen/emcy.hpp"
-#include "drivers/canopen/frame_stats.hpp"
-#include "drivers/canopen/nmt.hpp"
-#include "drivers/canopen/pdo.hpp"
-#include "drivers/canopen/sdo.hpp"
+#include "drivers/canopen/protocol/can_frame.hpp"
+#include "drivers/canopen/protocol/cia408.hpp"
+#include "drivers/canopen/protocol/cob_id.hpp"
+#include "drivers/canopen/protocol/emcy.hpp"
+#include "drivers/canopen/protocol/frame_stats.hpp"
+#include "drivers/canopen/protocol/nmt.hpp"
+#include "drivers/canopen/protocol/pdo.hpp"
+#include "drivers/canopen/protocol/sdo.hpp"
 
 using namespace rigctl::canopen;
 

@@ -1,6 +1,6 @@
-// Fuzzes Modbus response decoding: drivers/modbus_codec.cpp (read planning,
+// Fuzzes Modbus response decoding: drivers/modbus/modbus_codec.cpp (read planning,
 // register blocks to raw values in every format and word order, and back) and
-// drivers/calibration.cpp (raw to SI, linear and table), the path the DAQ's
+// drivers/modbus/calibration.cpp (raw to SI, linear and table), the path the DAQ's
 // I/O thread takes from a read reply to Sample values.
 //
 // Input (front to back, see make_seeds.py): plan options (max_gap i8,
@@ -19,8 +19,8 @@
 #include <string_view>
 #include <vector>
 
-#include "drivers/calibration.hpp"
-#include "drivers/modbus_codec.hpp"
+#include "drivers/modbus/calibration.hpp"
+#include "drivers/modbus/modbus_codec.hpp"
 #include "tests/fuzz/fuzz_input.hpp"
 
 using namespace rigctl;

@@ -1,4 +1,4 @@
-// Fuzzes the operator-command decoder, tools/operator_auth.cpp: the bytes of
+// Fuzzes the operator-command decoder, rt/comms/operator_auth.cpp: the bytes of
 // one LCM operator_command_t from the network, which must be "pure and total:
 // any bytes, any size, never throws or crashes; garbage gives kMalformed".
 // Raw bytes alone stop at the HMAC check, so each input is used three ways:
@@ -25,7 +25,7 @@
 #include <vector>
 
 #include "tests/fuzz/fuzz_input.hpp"
-#include "tools/operator_auth.hpp"
+#include "rt/comms/operator_auth.hpp"
 
 using namespace rigctl;
 using fuzz::check;

@@ -1,5 +1,5 @@
 // Fuzzes the run-file (CSV) reader of docs/run-files.md,
-// tools/run_file.cpp. The first input byte picks the options (rig kind's
+// tools/runfile/run_file.cpp. The first input byte picks the options (rig kind's
 // columns or keep-all, drop_bad_rows, min_rows); the rest is the file.
 // RunFileError is the reader's documented answer; anything else is a bug.
 // Checks the reader's promises on what it returns: t strictly increasing,
@@ -12,7 +12,7 @@
 #include <sstream>
 #include <string>
 
-#include "tools/run_file.hpp"
+#include "tools/runfile/run_file.hpp"
 
 namespace {
 

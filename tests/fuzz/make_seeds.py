@@ -101,7 +101,7 @@ def run_file_seeds():
     write("run_file", "header_only.csv", bytes([0x00]) + b"# only: metadata\n\nt, a ,a\n")
     # Regressions: finite times spanning more than a double holds gave an
     # infinite resampling grid (UB casting inf to size_t, then a huge
-    # allocation) or dt = inf (fixed in tools/run_file.cpp).
+    # allocation) or dt = inf (fixed in tools/runfile/run_file.cpp).
     write("run_file", "regression-huge_span_jitter.csv",
           bytes([0x00]) + b"t,a\n-1.6e308,0\n-0.6e308,0\n0.5e308,0\n1.5e308,0\n")
     write("run_file", "regression-infinite_step.csv", bytes([0x00]) + b"t,a\n-1.7e308,0\n1.7e308,0\n")

@@ -1,0 +1,44 @@
+#include "rt/control/pi_controller.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace rigctl {
+
+PiController::PiController(const PiConfig& config) : config_(config) {
+  if (config.period_s <= 0.0) throw std::invalid_argument("PI period must be positive");
+  if (config.output_limit <= 0.0) throw std::invalid_argument("PI output limit must be positive");
+}
+
+void PiController::update(double setpoint, const Sample& sample, Command& command,
+                          ControllerTerms& terms) noexcept {
+  const double measurement = sample.value[static_cast<std::size_t>(config_.feedback_input)];
+  const double error = setpoint - measurement;
+  const double limit = config_.output_limit;
+
+  const double p = config_.kp * error;
+  const double candidate = integrator_ + config_.ki * config_.period_s * error;
+  const double unsat_with_candidate = p + candidate;
+  bool held = false;
+  if (config_.anti_windup == AntiWindup::kConditional &&
+      ((unsat_with_candidate > limit && error > 0.0) || (unsat_with_candidate < -limit && error < 0.0))) {
+    held = true;  // integrating would only push further into saturation
+  } else {
+    integrator_ = candidate;
+  }
+  const double unsaturated = p + integrator_;
+  const double output = std::clamp(unsaturated, -limit, limit);
+
+  command.value[static_cast<std::size_t>(config_.output_index)] = output;
+  terms.setpoint = setpoint;
+  terms.measurement = measurement;
+  terms.error = error;
+  terms.term[0] = p;
+  terms.term[1] = integrator_;
+  terms.output_unsaturated = unsaturated;
+  terms.output = output;
+  terms.saturated = unsaturated != output;
+  terms.integrator_held = held;
+}
+
+}  // namespace rigctl

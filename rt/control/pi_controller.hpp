@@ -1,0 +1,49 @@
+// The PI law of seed 000 (eq. 9-10), written as a true discrete integrator
+// (the paper's u = Kp e + Ki e Ts has none; docs/rig-models.md 1.5.5):
+//   e_k = r_k - y_k,  I_k = I_{k-1} + Ki Ts e_k,  u_k = sat(Kp e_k + I_k)
+#pragma once
+
+#include "rt/control/controller.hpp"
+
+namespace rigctl {
+
+// Anti-windup strategy.
+enum class AntiWindup {
+  // Conditional integration (clamping): the integrator is held on a tick
+  // where the output is saturated and the error would drive it further into
+  // saturation. Simple, no extra tuning parameter, and the integrator resumes
+  // the moment the error changes sign, so the loop leaves saturation without
+  // the overshoot of a wound-up integrator.
+  kConditional,
+  // Plain integration; only for comparison in tests.
+  kNone,
+};
+
+struct PiConfig {
+  double kp = 80.0;            // [1/m]: output per metre of error
+  double ki = 60.0;            // [1/(m s)]
+  double period_s = 0.0025;    // Ts [s]
+  double output_limit = 1.0;   // |u| <= limit (fraction of rated valve current)
+  AntiWindup anti_windup = AntiWindup::kConditional;
+  int feedback_input = 0;      // index of the measured channel in the sample
+  int output_index = 0;        // index of the command output
+};
+
+class PiController final : public Controller {
+ public:
+  explicit PiController(const PiConfig& config);
+  const std::string& name() const override { return name_; }
+  const std::vector<std::string>& term_names() const override { return term_names_; }
+  void reset() noexcept override { integrator_ = 0.0; }
+  void update(double setpoint, const Sample& sample, Command& command, ControllerTerms& terms) noexcept override;
+
+  double integrator() const noexcept { return integrator_; }
+
+ private:
+  PiConfig config_;
+  std::string name_ = "pi";
+  std::vector<std::string> term_names_{"p", "i"};
+  double integrator_ = 0.0;
+};
+
+}  // namespace rigctl

@@ -1,0 +1,237 @@
+// Hidden-effect tests of the pneumatic rotary diagnosis (issue 6). Runs are
+// made by `rigctl make-run` (the plant's own effect models: trapezoid
+// hysteresis and brake with stick/slip, a sharp spool overlap under the real
+// 50 Hz dither, the driver's cubic delay line) and diagnosed through the
+// library with the rig's shipped config. What was hidden comes from the
+// generator itself (apply() on the same config), so no physical size is
+// repeated here.
+//
+// Strength tolerances follow docs/diagnosis.md 7: +-10 % at the
+// strong level, +-20 % at the weak one, on the departure of the effect's
+// size from its null. Where the fitted and the generating formulas differ,
+// the compared quantity is the physically equivalent one:
+//  * bladder_hysteresis: the half-width of the major loop, H = h_s + T_e of
+//    the fitted step + Dahl element against the trapezoid's boundary
+//    level x max torque (both are the torque the element holds after a long
+//    monotone travel, which every step of the excitation exceeds);
+//  * valve_deadband: the fitted overlap delta [V of command] against the
+//    plant's spool overlap divided by the solenoid gain;
+//  * polytropic_exponent: 1.4 - n, the departure from adiabatic.
+//
+// CPU: every case is a 9.7 s run (0.1 s to make) and one diagnosis of
+// 0.5-4 s; the cases of one test run two at a time (the CI machine has two
+// cores). Each test does only its own cases, so the total is the same
+// whether ctest runs the tests as separate processes or not.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <mutex>
+#include <span>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "config/rig_config.hpp"
+#include "plant/pneumatic_rotary/pneumatic_rotary_plant.hpp"
+#include "process.hpp"
+#include "tools/diagnosis/engine.hpp"
+#include "tools/diagnosis/model.hpp"
+#include "tools/hidden_effects/make_run.hpp"
+#include "tools/runfile/run_file.hpp"
+
+namespace rigctl {
+namespace {
+
+const std::string kRig = "pneumatic_rotary";
+const std::string kConfig = RIGCTL_SOURCE_DIR "/config/pneumatic_rotary.yaml";
+
+struct Case {
+  std::string name;
+  std::vector<std::pair<std::string, double>> effects;  // cause, level
+};
+
+struct Outcome {
+  std::string error;  // make-run or diagnosis failed
+  diag::Diagnosis d;
+};
+
+std::string make_run_file(const Case& c) {
+  const std::string csv = ::testing::TempDir() + "/pneu_" + c.name + ".csv";
+  std::string cmd = std::string(RIGCTL_BINARY) + " make-run --rig " + kRig + " --config " + kConfig + " --out " + csv;
+  for (const auto& [cause, level] : c.effects) cmd += " --effect " + cause + ":" + std::to_string(level);
+  const auto r = test::run_command(cmd);
+  if (r.exit_code != 0) throw std::runtime_error("make-run failed: " + r.output);
+  return csv;
+}
+
+Outcome make_and_diagnose(const Case& c) {
+  Outcome o;
+  try {
+    const auto rf = read_run_file(make_run_file(c), run_file_columns(kRig));
+    diag::RigModelOptions mo;
+    mo.config_path = kConfig;
+    const auto model = diag::make_rig_model(kRig, rf, mo);
+    o.d = diag::diagnose(*model, {});
+  } catch (const std::exception& e) {
+    o.error = e.what();
+  }
+  return o;
+}
+
+// Runs the cases two at a time.
+std::vector<Outcome> run_all(const std::vector<Case>& cases) {
+  std::vector<Outcome> out(cases.size());
+  std::atomic<std::size_t> next{0};
+  auto worker = [&] {
+    for (std::size_t i; (i = next++) < cases.size();) out[i] = make_and_diagnose(cases[i]);
+  };
+  std::thread a(worker), b(worker);
+  a.join();
+  b.join();
+  return out;
+}
+
+AppliedEffect truth_of(const std::string& cause, double level) {
+  const auto& gen = effect_generator(kRig);
+  RigConfig c = load_rig_config(kConfig, gen.excitation_case);
+  gen.make_clean(c);
+  return gen.apply(c, cause, level);
+}
+
+double param(const diag::CauseResult& c, const std::string& name) {
+  for (const auto& p : c.parameters)
+    if (p.name == name) return p.value;
+  ADD_FAILURE() << c.cause << " has no parameter " << name;
+  return NAN;
+}
+
+// The effect's size as a departure from its null, fitted and true (see the top).
+struct Sizes {
+  double fitted, truth;
+};
+Sizes sizes(const diag::CauseResult& c, const AppliedEffect& t) {
+  const auto& tr = t.truth;
+  if (c.cause == "bladder_hysteresis") return {param(c, "h_s") + param(c, "T_e"), tr.at("H")};
+  if (c.cause == "coulomb_friction") return {param(c, "T_c"), tr.at("T_c")};
+  if (c.cause == "polytropic_exponent") return {1.4 - param(c, "n"), 1.4 - tr.at("n")};
+  if (c.cause == "valve_null_offset") return {param(c, "u0"), tr.at("u0")};
+  if (c.cause == "valve_deadband") return {param(c, "delta"), tr.at("delta")};
+  if (c.cause == "sensor_delay") return {param(c, "tau"), tr.at("tau")};
+  ADD_FAILURE() << "no size comparison for " << c.cause;
+  return {NAN, NAN};
+}
+
+std::string summary(const diag::Diagnosis& d) {
+  std::string s = "cause " + d.cause + ";";
+  for (const auto& c : d.causes) {
+    s += " " + c.cause + " (gain " + std::to_string(c.gain_percent_points) + " pp:";
+    for (const auto& p : c.parameters) s += " " + p.name + "=" + std::to_string(p.value);
+    s += ")";
+  }
+  for (const auto& sc : d.screened) s += "\n  round " + std::to_string(sc.round) + " " + sc.cause + ": " + sc.reason;
+  return s;
+}
+
+void expect_single_cause_found(const std::vector<std::string>& causes, double level, double tolerance) {
+  std::vector<Case> cases;
+  for (const auto& c : causes) cases.push_back({c + (level == 1.0 ? "_strong" : "_weak"), {{c, level}}});
+  const auto out = run_all(cases);
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    const std::string& cause = causes[i];
+    SCOPED_TRACE(cases[i].name);
+    ASSERT_EQ(out[i].error, "");
+    const auto& d = out[i].d;
+    ASSERT_FALSE(d.causes.empty()) << summary(d);
+    EXPECT_EQ(d.cause, cause) << summary(d);
+    const auto& top = d.causes.front();
+    if (top.cause != cause) continue;
+    const AppliedEffect truth = truth_of(cause, level);
+    const Sizes s = sizes(top, truth);
+    EXPECT_NEAR(s.fitted, s.truth, tolerance * std::abs(s.truth)) << summary(d);
+    EXPECT_GE(top.gain_percent_points, 1.0) << "validated gain below g_min: " << summary(d);
+    EXPECT_GT(top.extended_fit_percent, top.baseline_fit_percent);
+    if (cause == "bladder_hysteresis") {
+      // Not just a Coulomb step: the fitted element keeps a travel-dependent
+      // (elastic) part, as the trapezoid's ramp has (half its swing).
+      const double share = param(top, "T_e") / s.fitted;
+      EXPECT_NEAR(share, 1.0 - 0.5, 0.15) << "elastic share of the fitted hysteresis";
+    }
+  }
+}
+
+TEST(DiagnosePneumatic, EveryStrongEffectIsNamedWithItsSize) {
+  expect_single_cause_found(effect_generator(kRig).causes, 1.0, 0.10);
+}
+
+// The confusable pair at about the paper's measured +-2 % level, the dead
+// band that the dither mostly smooths away, and the delay whose gain is the
+// smallest of all (about 1.6 pp, mostly from the phase of the 50 Hz ripple).
+TEST(DiagnosePneumatic, WeakEffectsAreNamedWithTheirSize) {
+  expect_single_cause_found({"bladder_hysteresis", "coulomb_friction", "valve_deadband", "sensor_delay"},
+                            weak_level(), 0.20);
+}
+
+TEST(DiagnosePneumatic, CleanRunIsNone) {
+  const auto out = run_all({{"clean", {}}});
+  ASSERT_EQ(out[0].error, "");
+  EXPECT_EQ(out[0].d.cause, "none") << summary(out[0].d);
+  EXPECT_TRUE(out[0].d.causes.empty());
+  // The baseline replay (dither averaged, not integrated) matches the plant
+  // to within the sensors' noise and quantisation.
+  EXPECT_GT(out[0].d.baseline_fit_percent.at("theta"), 98.0);
+  EXPECT_GT(out[0].d.baseline_fit_percent.at("dp"), 97.0);
+}
+
+// Through the program, as a user runs it: JSON and the HTML report.
+TEST(DiagnosePneumatic, HysteresisAndNullOffsetTogetherAreBothFound) {
+  const Case c{"bladder_and_offset", {{"bladder_hysteresis", 1.0}, {"valve_null_offset", 1.0}}};
+  const std::string csv = make_run_file(c);
+  const std::string json = ::testing::TempDir() + "/pneu_two.json", html = ::testing::TempDir() + "/pneu_two.html";
+  const auto r = test::run_command(std::string(RIGCTL_BINARY) + " diagnose --rig " + kRig + " --config " + kConfig +
+                                   " --data " + csv + " --json " + json + " --report " + html + " --quiet");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream jf(json);
+  const std::string j((std::istreambuf_iterator<char>(jf)), {});
+  EXPECT_NE(j.find("{\"cause\": \"bladder_hysteresis\""), std::string::npos) << j;
+  EXPECT_NE(j.find("{\"cause\": \"valve_null_offset\""), std::string::npos) << j;
+  // Sizes from the joint refit of both effects (final_parameters).
+  auto number_after = [&](const std::string& key) -> double {
+    const auto f = j.find("\"final_parameters\"");
+    const auto k = j.find("\"" + key + "\": ", f);
+    if (f == std::string::npos || k == std::string::npos) return NAN;
+    return std::stod(j.substr(k + key.size() + 4));
+  };
+  const double H = truth_of("bladder_hysteresis", 1.0).truth.at("H");
+  const double u0 = truth_of("valve_null_offset", 1.0).truth.at("u0");
+  EXPECT_NEAR(number_after("h_s") + number_after("T_e"), H, 0.10 * H);
+  EXPECT_NEAR(number_after("u0"), u0, 0.10 * u0);
+  std::ifstream hf(html);
+  const std::string h((std::istreambuf_iterator<char>(hf)), {});
+  EXPECT_NE(h.find("bladder_hysteresis vs travel since the last reversal"), std::string::npos);
+}
+
+// The dead band added to the plant for the generator: a sharp overlap of the
+// spool, no flow inside it, the opening less the overlap outside.
+TEST(PneumaticValveOverlap, NoFlowInsideTheOverlapAndReducedOpeningOutside) {
+  PneumaticRotaryParams p;
+  p.dither = false;
+  p.hysteresis.enabled = false;
+  p.valve_overlap = 0.75 * p.solenoid_gain;  // 0.75 V of command
+  PneumaticRotaryPlant plant(p);
+  EXPECT_EQ(plant.port_opening(0.5 * p.solenoid_gain), 0.0);
+  EXPECT_EQ(plant.port_opening(-0.7 * p.solenoid_gain), 0.0);
+  EXPECT_NEAR(plant.port_opening(2.0 * p.solenoid_gain), 1.25 * p.solenoid_gain, 1e-15);
+  EXPECT_NEAR(plant.port_opening(-2.0 * p.solenoid_gain), -1.25 * p.solenoid_gain, 1e-15);
+  // In the plant: a command inside the overlap leaves the pressures at rest.
+  const double u = 0.6;
+  for (int i = 0; i < 100; ++i) plant.advance(std::span<const double>(&u, 1), 0.0025);
+  EXPECT_EQ(plant.state().p_a, 0.0);
+  EXPECT_EQ(plant.state().theta, 0.0);
+}
+
+}  // namespace
+}  // namespace rigctl

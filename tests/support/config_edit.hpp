@@ -1,0 +1,47 @@
+// Config-error tests: a shipped config with one line edited must be refused
+// with a message naming the field. Shared by the rig-config tests.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <regex>
+#include <string>
+#include <vector>
+
+#include "config/config_reader.hpp"
+#include "config/rig_config.hpp"
+#include "read_file.hpp"
+#include "tools/run/rig_assembly.hpp"
+
+namespace rigctl::test {
+
+// config/<name> of the source tree as text.
+inline std::string shipped_config(const std::string& name = "quarter_car.yaml") {
+  return read_file(std::string(RIGCTL_SOURCE_DIR) + "/config/" + name);
+}
+
+// Replaces the first match of `pattern` (a regex); the pattern must match.
+inline std::string edit(const std::string& text, const std::string& pattern, const std::string& replacement) {
+  const std::regex re(pattern);
+  std::string out = std::regex_replace(text, re, replacement, std::regex_constants::format_first_only);
+  EXPECT_NE(out, text) << "pattern not found: " << pattern;
+  return out;
+}
+
+// The ConfigError that loading and assembling `yaml` gives, "" when accepted.
+inline std::string config_error_of(const std::string& yaml) {
+  try {
+    assemble_rig(parse_rig_config(yaml, "bad.yaml"));
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+inline void expect_config_error(const std::string& yaml, const std::vector<std::string>& fragments) {
+  const std::string e = config_error_of(yaml);
+  ASSERT_FALSE(e.empty()) << "config was accepted";
+  for (const auto& f : fragments) EXPECT_NE(e.find(f), std::string::npos) << "'" << f << "' not in: " << e;
+}
+
+}  // namespace rigctl::test

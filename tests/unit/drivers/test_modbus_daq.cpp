@@ -1,0 +1,684 @@
+// The Modbus DAQ client (ModbusDaq) against the simulated module
+// (SimModbusDaq), both real libmodbus over TCP on 127.0.0.1 (a free port),
+// and the `modbus:` config reader. No test asserts on this machine's timing
+// beyond generous bounds: conditions are polled with deadlines.
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <new>
+#include <cmath>
+#include <functional>
+#include <iostream>
+#include <limits>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "config/config_reader.hpp"
+#include "config/modbus_reader.hpp"
+#include "drivers/modbus/modbus_daq.hpp"
+#include "drivers/modbus/modbus_link.hpp"
+#include "drivers/sim/sim_modbus_daq.hpp"
+#include "rt/histogram.hpp"
+
+using namespace rigctl;
+
+// Counts this thread's heap allocations, to show the loop-side calls make none
+// (the I/O and server threads allocate freely and are not counted).
+namespace {
+thread_local long t_allocations = 0;
+}
+[[gnu::noinline]] void* operator new(std::size_t n) {
+  ++t_allocations;
+  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
+  throw std::bad_alloc();
+}
+[[gnu::noinline]] void* operator new[](std::size_t n) { return operator new(n); }
+[[gnu::noinline]] void operator delete(void* p) noexcept { std::free(p); }
+[[gnu::noinline]] void operator delete[](void* p) noexcept { std::free(p); }
+[[gnu::noinline]] void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+[[gnu::noinline]] void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Polls cond every millisecond until it holds or timeout_s passes.
+bool wait_until(const std::function<bool()>& cond, double timeout_s = 10.0) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (cond()) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  return cond();
+}
+
+ModbusChannel channel(const std::string& name, int unit, RegisterType type, int address, DataFormat format,
+                      WordOrder order, Calibration cal, double safe = 0.0) {
+  ModbusChannel c;
+  c.name = name;
+  c.unit = "1";
+  c.point = {unit, type, address, format, order};
+  c.calibration = std::move(cal);
+  c.safe = safe;
+  return c;
+}
+
+TableCalibration table(std::vector<double> raw, std::vector<double> si) { return TableCalibration(raw, si); }
+
+using enum DataFormat;
+using enum WordOrder;
+constexpr auto kIn = RegisterType::kInputRegister;
+constexpr auto kHold = RegisterType::kHoldingRegister;
+
+// Every data format and word order, both calibration kinds, an input kept in
+// holding registers and a second unit (three read blocks).
+ModbusDaqConfig rig_config() {
+  ModbusDaqConfig c;
+  c.connection.transport = ModbusTransport::kTcp;
+  c.connection.host = "127.0.0.1";
+  c.connection.port = 0;
+  c.connection.response_timeout_s = 0.02;  // tight for a LAN, loose enough for a loaded 2-core VM
+  c.connection.reconnect_interval_s = 0.05;
+  c.poll_period_s = 0.0025;
+  c.max_sample_age_s = 0.25;  // generous: "fresh" must not flicker under load
+  c.max_gap = 4;
+  c.inputs = {
+      channel("a", 1, kIn, 0, kInt16, kHighFirst, LinearCalibration(1e-4, 0.01)),
+      channel("b", 1, kIn, 1, kUint16, kHighFirstByteSwapped, table({0, 1000, 65535}, {0.0, 1.0e7, 2.5e7})),
+      channel("c", 1, kIn, 2, kInt32, kLowFirst, LinearCalibration(1e-6, 0.0)),
+      channel("d", 1, kIn, 4, kUint32, kLowFirstByteSwapped, LinearCalibration(0.5, -100.0)),
+      channel("e", 1, kIn, 6, kFloat32, kHighFirst, table({-10, 0, 10}, {-2.0e4, 0.0, 1.0e4})),
+      channel("f", 1, kIn, 8, kFloat32, kLowFirst, LinearCalibration(1.0, 0.0)),
+      channel("g", 1, kIn, 10, kFloat32, kHighFirstByteSwapped, LinearCalibration(2.0, 1.0)),
+      channel("h", 1, kHold, 20, kInt32, kHighFirst, LinearCalibration(1e-3, 0.0)),
+      channel("i", 2, kIn, 0, kInt16, kHighFirst, LinearCalibration(1e-3, 0.0)),
+  };
+  c.outputs = {
+      channel("u", 1, kHold, 0, kInt16, kHighFirst, LinearCalibration(3.0518e-5, 0.0), 0.0),
+      channel("v", 1, kHold, 1, kFloat32, kLowFirst, table({0, 5, 10}, {0.0, 1.0e6, 3.0e6}), 2.0e5),
+  };
+  return c;
+}
+
+// Quantisation of each input above, in SI: half a count for integers.
+const std::vector<double> kTolerance = {0.5e-4, 0.5e4, 0.5e-6, 0.25, 1e-3, 1e-6, 1e-6, 0.5e-3, 0.5e-3};
+const std::vector<double> kValuesA = {-0.1, 5.0e6, -0.123456, 1.0e6, 5000.0, 0.37, -3.5, 12.345, -1.5};
+const std::vector<double> kValuesB = {0.2, 1.2e7, 0.5, 3.0e4, -1.5e4, -42.0, 8.0, -7.5, 2.0};
+
+// What the chain SI -> raw -> registers -> raw -> SI must give, through the codec.
+double round_trip(const ModbusChannel& ch, double si) {
+  uint16_t regs[2] = {0, 0};
+  (void)encode_registers(ch.calibration.to_raw(si), ch.point.format, ch.point.order, regs);
+  return ch.calibration.to_si(decode_registers(regs, ch.point.format, ch.point.order));
+}
+
+// A simulated module and a client connected to it.
+class ModbusDaqTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    sim_ = std::make_unique<SimModbusDaq>(rig_config());
+    sim_->start();
+    sim_->set_inputs(kValuesA.data(), kValuesA.size());
+  }
+  void TearDown() override {
+    if (daq_) daq_->stop();
+    sim_->stop();
+  }
+
+  void start_client(ModbusDaqConfig c) {
+    daq_ = std::make_unique<ModbusDaq>(std::move(c));
+    daq_->start(10.0);
+  }
+  void start_client() { start_client(sim_->client_config()); }
+
+  Sample read() {
+    Sample s;
+    daq_->read_inputs(s, 0, ModbusDaq::now_ns());
+    return s;
+  }
+  bool all_fresh() { return read().status == 0; }
+  bool all_stale() {
+    const auto s = read();
+    return s.status == (1u << daq_->input_count()) - 1;
+  }
+  bool shows(const std::vector<double>& values) {
+    const Sample s = read();
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      if (((s.status >> i) & 1u) || std::abs(s.value[i] - values[i]) > kTolerance[i]) return false;
+    }
+    return true;
+  }
+  // Accumulates diagnostics() events (each call returns only the new ones).
+  std::string events() {
+    for (auto& e : daq_->diagnostics().events) events_ += e + "\n";
+    return events_;
+  }
+
+  std::unique_ptr<SimModbusDaq> sim_;
+  std::unique_ptr<ModbusDaq> daq_;
+  std::string events_;
+};
+
+TEST_F(ModbusDaqTest, InputsArriveInSiThroughEveryFormatOrderAndCalibration) {
+  start_client();
+  const auto& inputs = rig_config().inputs;
+  for (const auto* values : {&kValuesA, &kValuesB}) {
+    sim_->set_inputs(values->data(), values->size());
+    ASSERT_TRUE(wait_until([&] { return shows(*values); })) << "inputs never matched";
+    const Sample s = read();
+    for (std::size_t i = 0; i < inputs.size(); ++i) {
+      SCOPED_TRACE(inputs[i].name);
+      EXPECT_NEAR(s.value[i], (*values)[i], kTolerance[i]);
+      EXPECT_NEAR(s.value[i], round_trip(inputs[i], (*values)[i]), 1e-9 * std::max(1.0, std::abs(s.value[i])));
+    }
+  }
+  // Placed at an offset in the sample, other bits untouched.
+  Sample s;
+  s.status = 1u;
+  daq_->read_inputs(s, 3, ModbusDaq::now_ns());
+  EXPECT_EQ(s.status, 1u);
+  EXPECT_NEAR(s.value[3], kValuesB[0], kTolerance[0]);
+  EXPECT_NEAR(s.value[3 + 8], kValuesB[8], kTolerance[8]);
+  // Out of the sample's range: nothing written.
+  Sample untouched;
+  EXPECT_EQ(daq_->read_inputs(untouched, kMaxInputs - 2, ModbusDaq::now_ns()), std::numeric_limits<int64_t>::max());
+  EXPECT_EQ(untouched.value[kMaxInputs - 1], 0.0);
+
+  const auto c = daq_->counters();
+  EXPECT_TRUE(c.connected);
+  EXPECT_GT(c.reads, 0);
+  EXPECT_EQ(c.exceptions, 0);
+}
+
+TEST_F(ModbusDaqTest, OutputsWrittenByTheClientArriveDecodedOnTheServer) {
+  start_client();
+  double out[2] = {0, 0};
+  // Before the loop posts anything, the safe values are written.
+  ASSERT_TRUE(wait_until([&] {
+    sim_->outputs(out);
+    return out[0] == 0.0 && std::abs(out[1] - 2.0e5) < 1.0;
+  }));
+  const double command[2] = {0.25, 1.5e6};
+  daq_->write_outputs(command, 2);
+  ASSERT_TRUE(wait_until([&] {
+    sim_->outputs(out);
+    return std::abs(out[0] - 0.25) < 3.1e-5 && std::abs(out[1] - 1.5e6) < 1.0;
+  })) << out[0] << " " << out[1];
+
+  // A NaN is a fault: that output gets its safe value, the other keeps its command.
+  const double bad[2] = {kNaN, 2.0e6};
+  daq_->write_outputs(bad, 2);
+  ASSERT_TRUE(wait_until([&] {
+    sim_->outputs(out);
+    return out[0] == 0.0 && std::abs(out[1] - 2.0e6) < 1.0;
+  }));
+  EXPECT_GE(daq_->counters().rejected_outputs, 1);
+  EXPECT_NE(events().find("output u: 1 NaN commands replaced by the safe value"), std::string::npos) << events();
+
+  // Beyond the int16 range: clamped and counted.
+  const double big[2] = {5.0, 0.0};
+  daq_->write_outputs(big, 2);
+  ASSERT_TRUE(wait_until([&] {
+    sim_->outputs(out);
+    return std::abs(out[0] - 32767 * 3.0518e-5) < 1e-9;
+  }));
+  EXPECT_GT(daq_->counters().saturated_outputs, 0);
+
+  // make_safe() posts the safe values; stop() writes them as its last act.
+  daq_->make_safe();
+  ASSERT_TRUE(wait_until([&] {
+    sim_->outputs(out);
+    return out[0] == 0.0 && std::abs(out[1] - 2.0e5) < 1.0;
+  }));
+  daq_->write_outputs(command, 2);
+  ASSERT_TRUE(wait_until([&] {
+    sim_->outputs(out);
+    return std::abs(out[0] - 0.25) < 3.1e-5;
+  }));
+  daq_->stop();
+  sim_->outputs(out);
+  EXPECT_EQ(out[0], 0.0);
+  EXPECT_NEAR(out[1], 2.0e5, 1.0);
+}
+
+TEST_F(ModbusDaqTest, LoopSideReadNeverBlocksWhileTheIoThreadWaitsForATimeout) {
+  auto c = sim_->client_config();
+  c.connection.response_timeout_s = 0.3;  // the I/O thread sits 300 ms in each request
+  c.connection.reconnect_interval_s = 60.0;  // and never gives up on the connection here
+  start_client(c);
+  sim_->set_silent(true);
+  ASSERT_TRUE(wait_until([&] { return sim_->requests() > 0 && daq_->counters().timeouts > 0; }));
+
+  const int64_t timeouts_before = daq_->counters().timeouts;
+  DurationHistogram calls(100, 100000);  // 0.1 us bins up to 10 ms
+  Sample s;
+  const int64_t end = ModbusDaq::now_ns() + 1'500'000'000;  // spans a whole timeout + drain of 600 ms
+  while (ModbusDaq::now_ns() < end) {
+    const int64_t t0 = ModbusDaq::now_ns();
+    daq_->read_inputs(s, 0, t0);
+    calls.record(ModbusDaq::now_ns() - t0);
+  }
+  const auto summary = calls.summary();
+  std::cout << "read_inputs during a timeout: " << summary.count << " calls, p50 " << summary.p50_ns << " ns, p99 "
+            << summary.p99_ns << " ns, max " << summary.max_ns << " ns\n";
+  // The I/O thread really was stuck in timeouts meanwhile.
+  EXPECT_GT(daq_->counters().timeouts, timeouts_before);
+  // A call that waited for the I/O thread would take up to 300 ms. Generous
+  // bounds: this VM may preempt any single call for milliseconds.
+  EXPECT_LT(summary.p99_ns, 500'000);
+  EXPECT_LT(summary.max_ns, 100'000'000);
+}
+
+TEST_F(ModbusDaqTest, LoopSideCallsDoNotAllocate) {
+  start_client();
+  ASSERT_TRUE(wait_until([&] { return shows(kValuesA); }));
+  Sample s;
+  const double command[2] = {0.1, kNaN};
+  const long before = t_allocations;
+  for (int i = 0; i < 2000; ++i) {
+    const int64_t now = ModbusDaq::now_ns();
+    daq_->read_inputs(s, 0, now);
+    daq_->write_outputs(command, 2);
+    (void)daq_->output_age_ns(now);
+    if (i % 100 == 0) daq_->make_safe();
+    if (i == 1000) sim_->set_silent(true);  // and while requests time out
+  }
+  EXPECT_EQ(t_allocations - before, 0);
+}
+
+TEST_F(ModbusDaqTest, SilentServerMakesInputsStaleAndIsCountedAndLogged) {
+  start_client();
+  ASSERT_TRUE(wait_until([&] { return shows(kValuesA); }));
+  const double max_age = sim_->client_config().max_sample_age_s;
+
+  sim_->set_silent(true);
+  const auto t0 = std::chrono::steady_clock::now();
+  ASSERT_TRUE(wait_until([&] { return all_stale(); }));
+  const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  // Stale once older than max_sample_age (plus a timeout and a few cycles);
+  // the upper bound is generous for a loaded machine.
+  EXPECT_LT(took, max_age + 2.0);
+  // The last values are still there, flagged.
+  Sample s = read();
+  EXPECT_NEAR(s.value[0], kValuesA[0], kTolerance[0]);
+  EXPECT_GT(daq_->read_inputs(s, 0, ModbusDaq::now_ns()), static_cast<int64_t>(max_age * 1e9));
+
+  const auto c = daq_->counters();
+  EXPECT_GT(c.timeouts, 0);
+  EXPECT_GT(c.stale_samples, 0);
+  const std::string log = events();
+  EXPECT_NE(log.find("modbus " + sim_->endpoint() + ": timeout (no reply within 20 ms) reading input registers 0-11 of unit 1"),
+            std::string::npos)
+      << log;
+  EXPECT_NE(log.find("samples with stale inputs"), std::string::npos) << log;
+
+  sim_->set_silent(false);
+  ASSERT_TRUE(wait_until([&] { return all_fresh(); }));
+  EXPECT_NE(events().find("works again"), std::string::npos) << events();
+}
+
+TEST_F(ModbusDaqTest, LateRepliesTimeOutAndDoNotPoisonLaterRequests) {
+  auto c = sim_->client_config();
+  c.connection.reconnect_interval_s = 60.0;  // keep this connection: a new one would hide a backlog
+  start_client(c);
+  ASSERT_TRUE(wait_until([&] { return shows(kValuesA); }));
+  sim_->set_reply_delay(0.06);  // three response timeouts
+  ASSERT_TRUE(wait_until([&] { return all_stale(); }));
+  EXPECT_GT(daq_->counters().timeouts, 0);
+  // Replies now arrive long after their request; once on time again, the
+  // client must read current values, not a backlog of old replies.
+  sim_->set_reply_delay(0.0);
+  sim_->set_inputs(kValuesB.data(), kValuesB.size());
+  ASSERT_TRUE(wait_until([&] { return shows(kValuesB); }));
+  EXPECT_EQ(daq_->counters().connection_losses, 0);
+}
+
+TEST_F(ModbusDaqTest, OneLateReplyDoesNotLeaveTheConnectionOneReplyBehind) {
+  // One reply later than the timeout is consumed by the next request (wrong
+  // transaction id). If the client then only flushed at once, its own reply,
+  // still on its way, would poison the request after, and so on forever.
+  auto c = sim_->client_config();
+  c.connection.reconnect_interval_s = 60.0;  // a reconnect would hide the desynchronisation
+  start_client(c);
+  // Every reply takes 2 ms (well inside the 20 ms timeout), like a busy
+  // module's: a reply then always arrives after the client has handled a
+  // mismatch, which is when a plain flush cannot catch it.
+  sim_->set_reply_delay(0.002);
+  ASSERT_TRUE(wait_until([&] { return shows(kValuesA); }));
+  for (int episode = 0; episode < 3; ++episode) {
+    const int64_t timeouts = daq_->counters().timeouts;
+    sim_->set_reply_delay(0.03);  // 1.5 response timeouts, for the request being served now
+    ASSERT_TRUE(wait_until([&] { return daq_->counters().timeouts > timeouts; }));
+    sim_->set_reply_delay(0.002);
+    const double* values = episode % 2 == 0 ? kValuesB.data() : kValuesA.data();
+    sim_->set_inputs(values, kValuesA.size());
+    ASSERT_TRUE(wait_until([&] { return shows(episode % 2 == 0 ? kValuesB : kValuesA); }, 5.0))
+        << "episode " << episode << ": " << daq_->counters().protocol_errors << " bad replies\n" << events();
+    // And it stays in step: no further bad replies.
+    const int64_t bad = daq_->counters().protocol_errors;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    EXPECT_EQ(daq_->counters().protocol_errors, bad) << "episode " << episode;
+  }
+  EXPECT_EQ(daq_->counters().connection_losses, 0);
+}
+
+TEST_F(ModbusDaqTest, ExceptionResponsesAreCountedAndNameTheRegisters) {
+  start_client();
+  ASSERT_TRUE(wait_until([&] { return shows(kValuesA); }));
+  sim_->add_exception({1, kIn, 5, 5, 0x02});  // touches the block of input registers 0-11 of unit 1
+  ASSERT_TRUE(wait_until([&] { return daq_->counters().exceptions > 0; }));
+  const std::string expected =
+      "modbus " + sim_->endpoint() + ": exception 'Illegal data address' reading input registers 0-11 of unit 1";
+  ASSERT_TRUE(wait_until([&] { return events().find(expected) != std::string::npos; })) << events();
+
+  // Only that block's inputs go stale; the other blocks are still read.
+  ASSERT_TRUE(wait_until([&] { return read().status == 0x7Fu; }));
+  sim_->set_inputs(kValuesB.data(), kValuesB.size());
+  ASSERT_TRUE(wait_until([&] {
+    const Sample s = read();
+    return std::abs(s.value[7] - kValuesB[7]) <= kTolerance[7] && std::abs(s.value[8] - kValuesB[8]) <= kTolerance[8];
+  }));
+  EXPECT_TRUE(daq_->counters().connected);  // an exception is an answer: the link is fine
+
+  // Another code on the output write: the outputs stop being refreshed, and
+  // their age says so.
+  const int64_t max_age = static_cast<int64_t>(rig_config().max_sample_age_s * 1e9);
+  EXPECT_LT(daq_->output_age_ns(ModbusDaq::now_ns()), max_age);
+  sim_->add_exception({1, kHold, 0, 0, 0x04});
+  ASSERT_TRUE(wait_until([&] {
+    return events().find("exception '" + modbus_exception_text(4) +
+                         "' writing holding registers 0-2 of unit 1") != std::string::npos;
+  })) << events();
+  ASSERT_TRUE(wait_until([&] { return daq_->output_age_ns(ModbusDaq::now_ns()) > max_age; }));
+
+  sim_->clear_exceptions();
+  ASSERT_TRUE(wait_until([&] { return shows(kValuesB); }));
+  ASSERT_TRUE(wait_until([&] { return daq_->output_age_ns(ModbusDaq::now_ns()) < max_age; }));
+}
+
+TEST_F(ModbusDaqTest, DroppedConnectionReconnectsWithoutRestart) {
+  start_client();
+  ASSERT_TRUE(wait_until([&] { return shows(kValuesA); }));
+  EXPECT_EQ(daq_->counters().reconnects, 0);
+
+  sim_->drop_connections(0.6);  // and refuse new ones for a while
+  ASSERT_TRUE(wait_until([&] { return daq_->counters().connection_losses > 0; }));
+  // While disconnected the inputs age until stale.
+  ASSERT_TRUE(wait_until([&] { return all_stale(); }));
+  sim_->set_inputs(kValuesB.data(), kValuesB.size());
+  // Fresh values again from a new connection, same ModbusDaq object.
+  ASSERT_TRUE(wait_until([&] { return shows(kValuesB) && daq_->counters().connected; }));
+  const auto c = daq_->counters();
+  EXPECT_GE(c.reconnects, 1);
+  EXPECT_GE(sim_->connections(), 2);
+  const std::string log = events();
+  EXPECT_NE(log.find("connection lost"), std::string::npos) << log;
+  EXPECT_NE(log.find("reconnected"), std::string::npos) << log;
+  // Outputs flow again too.
+  const double command[2] = {-0.5, 1.0e6};
+  daq_->write_outputs(command, 2);
+  double out[2];
+  ASSERT_TRUE(wait_until([&] {
+    sim_->outputs(out);
+    return std::abs(out[0] + 0.5) < 3.1e-5;
+  }));
+}
+
+TEST_F(ModbusDaqTest, StuckAndOutOfRangeRegistersAreVisibleInSi) {
+  start_client();
+  ASSERT_TRUE(wait_until([&] { return shows(kValuesA); }));
+  sim_->set_stuck(0, true);
+  sim_->force_raw(8, 32767);  // the ADC rail of input i
+  sim_->force_raw(5, kNaN);   // a float module reporting NaN for f
+  sim_->set_inputs(kValuesB.data(), kValuesB.size());
+  ASSERT_TRUE(wait_until([&] {
+    const Sample s = read();
+    return std::abs(s.value[1] - kValuesB[1]) <= kTolerance[1] && std::abs(s.value[8] - 32.767) < 1e-9;
+  }));
+  const Sample s = read();
+  EXPECT_NEAR(s.value[0], kValuesA[0], kTolerance[0]);  // frozen, and it looks fresh: nothing on the wire says otherwise
+  EXPECT_EQ(s.status & 1u, 0u);
+  EXPECT_DOUBLE_EQ(s.value[8], 32.767);  // rail value in SI, for the limit check to judge
+  EXPECT_EQ((s.status >> 8) & 1u, 0u);
+  EXPECT_TRUE(std::isnan(s.value[5]));  // not a number: flagged invalid
+  EXPECT_EQ((s.status >> 5) & 1u, 1u);
+
+  sim_->clear_faults();
+  sim_->set_inputs(kValuesB.data(), kValuesB.size());
+  ASSERT_TRUE(wait_until([&] { return shows(kValuesB); }));
+}
+
+TEST_F(ModbusDaqTest, IoLatencyIsMeasured) {
+  auto c = sim_->client_config();
+  c.io_priority = 10;  // applied when permitted, else an event; either way the client runs
+  start_client(c);
+  ASSERT_TRUE(wait_until([&] { return daq_->io_latency().count >= 400; }));
+  const auto l = daq_->io_latency();
+  std::cout << "I/O cycle (3 reads + 1 write) on loopback: " << l.count << " cycles, p50 " << l.p50_ns / 1000.0
+            << " us, p99 " << l.p99_ns / 1000.0 << " us, p99.9 " << l.p999_ns / 1000.0 << " us, max "
+            << l.max_ns / 1000.0 << " us\n";
+  EXPECT_GT(l.min_ns, 0);
+  EXPECT_LE(l.p50_ns, l.p99_ns);
+  EXPECT_LE(l.p99_ns, l.max_ns);
+  const auto d = daq_->diagnostics();
+  auto counter = [&](const std::string& name) {
+    for (const auto& [n, v] : d.counters) {
+      if (n == name) return v;
+    }
+    return int64_t{-1};
+  };
+  EXPECT_EQ(counter("modbus_connected"), 1);
+  EXPECT_GE(counter("modbus_cycles"), 400);
+  EXPECT_GE(counter("modbus_reads"), 3 * 400);
+  EXPECT_EQ(counter("modbus_reconnects"), 0);
+}
+
+TEST(ModbusDaqStart, AgainstAClosedPortThrowsNamingHostAndPort) {
+  // A port nobody listens on: bind one, note it, close it.
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+  socklen_t len = sizeof addr;
+  getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
+  close(fd);
+
+  auto c = rig_config();
+  c.connection.port = ntohs(addr.sin_port);
+  ModbusDaq daq(c);
+  try {
+    daq.start(0.5);
+    FAIL() << "start() succeeded against a closed port";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("127.0.0.1:" + std::to_string(c.connection.port)), std::string::npos) << what;
+    EXPECT_NE(what.find("Connection refused"), std::string::npos) << what;
+  }
+  EXPECT_GT(daq.counters().connect_failures, 0);
+  EXPECT_FALSE(daq.counters().connected);
+}
+
+TEST(ModbusDaqConfig, ConstructorRejectsBadConfigs) {
+  auto c = rig_config();
+  c.outputs[1].point.type = kIn;
+  EXPECT_THROW(ModbusDaq{c}, std::invalid_argument);
+  c = rig_config();
+  c.outputs[1].point.address = 0;  // overlaps u
+  EXPECT_THROW(ModbusDaq{c}, std::invalid_argument);
+  c = rig_config();
+  c.max_sample_age_s = c.poll_period_s / 2;
+  EXPECT_THROW(ModbusDaq{c}, std::invalid_argument);
+  c = rig_config();
+  c.connection.transport = ModbusTransport::kRtu;  // no device
+  EXPECT_THROW(ModbusDaq{c}, std::invalid_argument);
+}
+
+// ---------------------------------------------------------------------------
+// Config reader
+
+const char* kGoodSection = R"(modbus:
+  transport: tcp
+  host: 127.0.0.1
+  port: 1502
+  device: /dev/ttyUSB0      # rtu keys may stay; checked, unused
+  baud: 115200
+  parity: N
+  data_bits: 8
+  stop_bits: 1
+  response_timeout_s: 0.002
+  reconnect_interval_s: 0.5
+  max_sample_age_s: 0.0075
+  max_gap: 4
+  inputs:
+    x_r: {unit: m, unit_id: 1, register: input, address: 0, format: int16, order: high_first, calibration: {gain: 6.1035e-6, offset: 0.0}}
+    p1:  {unit: Pa, unit_id: 1, register: input, address: 5, format: float32, order: low_first, calibration: {table: {raw: [0, 1000, 2000], si: [0.0, 1.0e7, 2.05e7]}}}
+    f_t: {unit: N, unit_id: 2, register: holding, address: 10, format: uint16, calibration: {gain: 0.5, offset: -1000}}
+  outputs:
+    u: {unit: "1", unit_id: 1, register: holding, address: 0, format: int16, order: high_first, calibration: {gain: 3.0518e-5, offset: 0.0}, safe: 0.0}
+)";
+
+ModbusDaqConfig parse(const std::string& text) {
+  auto root = ConfigReader::from_string(text, "rig.yaml");
+  auto c = read_modbus_daq(root.child("modbus"), 0.0025);
+  root.reject_unknown_keys();
+  return c;
+}
+
+// Replaces the first occurrence of `from` in text.
+std::string edit(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  if (at == std::string::npos) throw std::logic_error("test edit: '" + from + "' not in the section");
+  return text.replace(at, from.size(), to);
+}
+std::string edited(const std::string& from, const std::string& to) { return edit(kGoodSection, from, to); }
+
+// The good section as RTU, with a timeout that fits its frames at 115200 baud.
+std::string rtu_section() {
+  return edit(edited("transport: tcp", "transport: rtu"), "response_timeout_s: 0.002", "response_timeout_s: 0.005");
+}
+
+std::string error_of(const std::string& text) {
+  try {
+    parse(text);
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(ModbusReader, GoodSectionParses) {
+  const auto c = parse(kGoodSection);
+  EXPECT_EQ(c.connection.transport, ModbusTransport::kTcp);
+  EXPECT_EQ(c.connection.host, "127.0.0.1");
+  EXPECT_EQ(c.connection.port, 1502);
+  EXPECT_DOUBLE_EQ(c.connection.response_timeout_s, 0.002);
+  EXPECT_DOUBLE_EQ(c.connection.reconnect_interval_s, 0.5);
+  EXPECT_DOUBLE_EQ(c.poll_period_s, 0.0025);  // the default: the loop period
+  EXPECT_DOUBLE_EQ(c.max_sample_age_s, 0.0075);
+  EXPECT_EQ(c.max_gap, 4);
+  ASSERT_EQ(c.inputs.size(), 3u);
+  EXPECT_EQ(c.inputs[0].name, "x_r");
+  EXPECT_EQ(c.inputs[0].unit, "m");
+  EXPECT_DOUBLE_EQ(c.inputs[0].calibration.to_si(1000), 6.1035e-3);
+  EXPECT_EQ(c.inputs[1].point.format, DataFormat::kFloat32);
+  EXPECT_EQ(c.inputs[1].point.order, WordOrder::kLowFirst);
+  ASSERT_NE(c.inputs[1].calibration.table(), nullptr);
+  EXPECT_DOUBLE_EQ(c.inputs[1].calibration.to_si(1500), 1.525e7);
+  EXPECT_EQ(c.inputs[2].point.unit_id, 2);
+  EXPECT_EQ(c.inputs[2].point.type, RegisterType::kHoldingRegister);
+  EXPECT_EQ(c.inputs[2].point.order, WordOrder::kHighFirst);  // 16-bit default
+  ASSERT_EQ(c.outputs.size(), 1u);
+  EXPECT_EQ(c.outputs[0].name, "u");
+  EXPECT_DOUBLE_EQ(c.outputs[0].safe, 0.0);
+  EXPECT_EQ(c.io_priority, 0);  // optional: normal scheduling
+  EXPECT_NO_THROW(ModbusDaq{c});
+  EXPECT_EQ(parse(edited("  max_gap: 4\n", "  max_gap: 4\n  io_priority: 79\n")).io_priority, 79);
+
+  const auto rtu = parse(rtu_section());
+  EXPECT_EQ(rtu.connection.transport, ModbusTransport::kRtu);
+  EXPECT_EQ(rtu.connection.device, "/dev/ttyUSB0");
+  EXPECT_EQ(rtu.connection.baud, 115200);
+  EXPECT_EQ(rtu.connection.parity, 'N');
+  EXPECT_NO_THROW(ModbusDaq{rtu});
+  // RTU without the TCP keys, with an explicit poll period.
+  const auto rtu2 = parse(edit(rtu_section(), "  host: 127.0.0.1\n  port: 1502\n", "  poll_period_s: 0.005\n"));
+  EXPECT_DOUBLE_EQ(rtu2.poll_period_s, 0.005);
+}
+
+struct BadCase {
+  std::string name, from, to, expected;
+  bool rtu = false;  // edit the RTU variant
+};
+
+TEST(ModbusReader, EachBadCaseNamesTheKey) {
+  const std::vector<BadCase> cases = {
+      {"missing key", "  response_timeout_s: 0.002\n", "", "rig.yaml:2: modbus.response_timeout_s: missing required key"},
+      {"unknown key", "  max_gap: 4\n", "  max_gap: 4\n  retries: 3\n", "rig.yaml:14: modbus.retries: unknown key"},
+      {"unknown channel key", "safe: 0.0}", "safe: 0.0, scale: 2}", "modbus.outputs.u.scale: unknown key"},
+      {"bad format name", "format: int16, order: high_first, calibration: {gain: 6.1035e-6",
+       "format: int17, order: high_first, calibration: {gain: 6.1035e-6",
+       "rig.yaml:15: modbus.inputs.x_r.format: unknown value 'int17'"},
+      {"bad order name", "order: low_first", "order: middle_endian", "modbus.inputs.p1.order: unknown value 'middle_endian'"},
+      {"32-bit without order", "format: float32, order: low_first,", "format: float32,",
+       "modbus.inputs.p1.order: missing required key"},
+      {"bad transport", "transport: tcp", "transport: udp", "modbus.transport: unknown value 'udp'"},
+      {"rtu without device", "  device: /dev/ttyUSB0      # rtu keys may stay; checked, unused\n", "",
+       "modbus.device: missing required key", true},
+      {"tcp without host", "  host: 127.0.0.1\n", "", "modbus.host: missing required key"},
+      {"bad parity", "parity: N", "parity: X", "modbus.parity: unknown value 'X'"},
+      {"bad parity, unused under tcp, still checked", "parity: N", "parity: none", "modbus.parity: unknown value 'none'"},
+      {"rtu without baud", "  baud: 115200\n", "", "modbus.baud: missing required key", true},
+      {"rtu broadcast unit", "unit_id: 2", "unit_id: 0", "modbus.inputs.f_t.unit_id: must be in [1, 247]", true},
+      {"output in an input register", "u: {unit: \"1\", unit_id: 1, register: holding",
+       "u: {unit: \"1\", unit_id: 1, register: input", "modbus.outputs.u.register: outputs must be holding registers"},
+      {"output without safe", ", safe: 0.0}", "}", "modbus.outputs.u.safe: missing required key"},
+      {"gain and table", "calibration: {table: {raw:", "calibration: {gain: 1, table: {raw:",
+       "modbus.inputs.p1.calibration.table: give either gain and offset, or table"},
+      {"table not increasing", "raw: [0, 1000, 2000]", "raw: [0, 2000, 1000]", "modbus.inputs.p1.calibration.table"},
+      {"table lengths differ", "si: [0.0, 1.0e7, 2.05e7]", "si: [0.0, 1.0e7]", "modbus.inputs.p1.calibration.table.si"},
+      {"zero gain", "{gain: 0.5, offset: -1000}", "{gain: 0, offset: -1000}", "modbus.inputs.f_t.calibration.gain"},
+      {"address beyond the table", "address: 5, format: float32", "address: 65535, format: float32",
+       "modbus.inputs.p1.address"},
+      {"unit id out of range", "unit_id: 2", "unit_id: 256", "modbus.inputs.f_t.unit_id: must be in [0, 255]"},
+      {"stale before the first poll", "max_sample_age_s: 0.0075", "max_sample_age_s: 0.001",
+       "modbus.max_sample_age_s: must be at least the poll period"},
+      {"io priority out of range", "  max_gap: 4\n", "  max_gap: 4\n  io_priority: 120\n",
+       "modbus.io_priority: must be in [0, 99]"},
+      {"non-numeric timeout", "response_timeout_s: 0.002", "response_timeout_s: fast",
+       "modbus.response_timeout_s: expected a number"},
+  };
+  for (const auto& c : cases) {
+    const std::string error = error_of(edit(c.rtu ? rtu_section() : kGoodSection, c.from, c.to));
+    EXPECT_NE(error.find(c.expected), std::string::npos) << c.name << ": got \"" << error << "\"";
+    EXPECT_EQ(error.rfind("rig.yaml:", 0), 0u) << c.name << ": no file:line in \"" << error << "\"";
+  }
+}
+
+TEST(ModbusReader, RtuTimeoutMustFitTheFramesAtTheBaudRate) {
+  // At 115200 baud the 7-register read (x_r..p1) and its request take 27
+  // bytes, 2.3 ms: a 2 ms timeout would fail every time.
+  const std::string tight = edited("transport: tcp", "transport: rtu");
+  const std::string e = error_of(tight);
+  EXPECT_NE(e.find("rig.yaml:10: modbus.response_timeout_s: 0.002 s is shorter than the 27 bytes"), std::string::npos) << e;
+  EXPECT_EQ(error_of(rtu_section()), "(no error)");
+  const std::string slow = edit(rtu_section(), "baud: 115200", "baud: 9600");
+  EXPECT_NE(error_of(slow).find("modbus.response_timeout_s"), std::string::npos) << error_of(slow);
+  // The same section over TCP has no such limit.
+  EXPECT_EQ(error_of(kGoodSection), "(no error)");
+}
+
+TEST(ModbusReader, OverlappingOutputsAreRejected) {
+  std::string s = kGoodSection;
+  s += "    v: {unit: \"1\", unit_id: 1, register: holding, address: 0, format: uint16, "
+       "calibration: {gain: 1, offset: 0}, safe: 0}\n";
+  EXPECT_NE(error_of(s).find("modbus.outputs.v: shares registers with output u"), std::string::npos) << error_of(s);
+}
+
+}  // namespace

@@ -1,0 +1,237 @@
+// Scaling section (Google Benchmark): how the cost of one plant period grows
+// with the RK4 sub-steps, and how the tick (read, limit check, demand,
+// controller, write: what RigLoop times as compute) grows with the number of
+// servo-hydraulic actuators, each a quarter-car post with its own PI loop
+// (1, 2, 4, 8: quarter car, two-post half car, four-poster, two four-posters).
+// One RigLoop cannot hold 8 actuators (rt/sample.hpp: 24 inputs, 4
+// outputs), so the tick here runs the same steps over N assembled rigs,
+// each running the 20 s step test of config/quarter_car.yaml over and over.
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <map>
+#include <span>
+
+#include "config/rig_config.hpp"
+#include "tools/bench/sections.hpp"
+#include "tools/run/rig_assembly.hpp"
+
+namespace rigctl::bench {
+
+namespace {
+
+struct Measured {
+  double ns_per_iteration = 0.0;
+  int64_t iterations = 0;
+};
+
+class CollectingReporter final : public benchmark::BenchmarkReporter {
+ public:
+  bool ReportContext(const Context&) override { return true; }
+  void ReportRuns(const std::vector<Run>& runs) override {
+    for (const auto& r : runs) {
+      if (r.error_occurred || r.run_type != Run::RT_Iteration) continue;
+      double t = r.GetAdjustedRealTime();
+      switch (r.time_unit) {
+        case benchmark::kNanosecond: break;
+        case benchmark::kMicrosecond: t *= 1e3; break;
+        case benchmark::kMillisecond: t *= 1e6; break;
+        case benchmark::kSecond: t *= 1e9; break;
+      }
+      // The name carries the settings too ("NAME/min_time:0.500"): keep NAME.
+      std::string name = r.benchmark_name();
+      const auto cut = name.find("/min_time:");
+      if (cut != std::string::npos) name.erase(cut);
+      results[name] = {t, static_cast<int64_t>(r.iterations)};
+    }
+  }
+  std::map<std::string, Measured> results;
+};
+
+void initialise_google_benchmark() {
+  static bool done = false;
+  if (done) return;
+  int argc = 1;
+  char name[] = "rigctl-bench";
+  char* argv[] = {name, nullptr};
+  benchmark::Initialize(&argc, argv);
+  done = true;
+}
+
+// One post of a multi-actuator rig: the parts assemble_rig makes.
+struct Post {
+  AssembledRig rig;
+  Sample sample;
+  Command command;
+  ControllerTerms terms;
+  int64_t tick = 0;
+};
+
+}  // namespace
+
+Section scaling_section() {
+  return {"scaling", "scaling: plant cost vs sub-steps, tick time vs actuators (Google Benchmark)", [](Context& ctx) {
+            initialise_google_benchmark();
+            const double min_time = ctx.pick(0.5, 0.02);
+            const RigConfig qc = load_rig_config(ctx.quarter_car_config);
+            const RigConfig pn = load_rig_config(ctx.pneumatic_config);
+            const double T = qc.loop.period_s;
+            const int64_t ticks = std::llround(20.0 / T);
+            const CommandSeries qc_u = closed_loop_commands(qc, ticks);
+            const CommandSeries pn_u = closed_loop_commands(pn, ticks);
+            const CommandSeries passive(static_cast<std::size_t>(ticks), HeldCommand{0.0, 0.0});
+            const HalfCarParams hc;
+
+            struct PlantCase {
+              std::string name;
+              int default_substeps;
+              std::function<std::unique_ptr<SimulatedPlant>(int)> make;
+              const CommandSeries* u;
+            };
+            const std::vector<PlantCase> plants = {
+                {"quarter_car", qc.quarter_car.substeps,
+                 [&](int n) {
+                   QuarterCarParams p = qc.quarter_car;
+                   p.substeps = n;
+                   return std::unique_ptr<SimulatedPlant>(new QuarterCarPlant(p));
+                 },
+                 &qc_u},
+                {"pneumatic_rotary", pn.pneumatic_rotary.substeps,
+                 [&](int n) {
+                   PneumaticRotaryParams p = pn.pneumatic_rotary;
+                   p.substeps = n;
+                   return std::unique_ptr<SimulatedPlant>(new PneumaticRotaryPlant(p));
+                 },
+                 &pn_u},
+                {"half_car_bump", hc.substeps,
+                 [&](int n) {
+                   HalfCarParams p = hc;
+                   p.substeps = n;
+                   return std::unique_ptr<SimulatedPlant>(new HalfCarPlant(p));
+                 },
+                 &passive},
+            };
+
+            std::vector<std::pair<std::string, std::pair<std::string, int>>> plant_benchmarks;  // name -> (plant, substeps)
+            for (const auto& pc : plants) {
+              for (const double m : {0.25, 0.5, 1.0, 2.0, 4.0}) {
+                const int n = std::max(1, static_cast<int>(std::lround(pc.default_substeps * m)));
+                const std::string name = "plant/" + pc.name + "/substeps:" + std::to_string(n);
+                const CommandSeries* u = pc.u;
+                auto make = pc.make;
+                benchmark::RegisterBenchmark(name.c_str(),
+                                             [make, n, u, T](benchmark::State& state) {
+                                               auto plant = make(n);
+                                               plant->reset();
+                                               const std::size_t nc = plant->commands().size();
+                                               std::size_t k = 0;
+                                               for (auto _ : state) {
+                                                 plant->advance(std::span<const double>((*u)[k].data(), nc), T);
+                                                 if (++k == u->size()) {
+                                                   k = 0;
+                                                   plant->reset();
+                                                 }
+                                               }
+                                             })
+                    ->MinTime(min_time)
+                    ->Unit(benchmark::kNanosecond);
+                plant_benchmarks.push_back({name, {pc.name, n}});
+              }
+            }
+
+            const std::vector<int> posts_list = {1, 2, 4, 8};
+            for (const int posts : posts_list) {
+              const std::string name = "tick/actuators:" + std::to_string(posts);
+              benchmark::RegisterBenchmark(name.c_str(),
+                                           [&qc, posts, run_ticks = ticks](benchmark::State& state) {
+                                             std::vector<std::unique_ptr<Post>> rig;
+                                             for (int i = 0; i < posts; ++i) {
+                                               auto p = std::make_unique<Post>();
+                                               RigConfig c = qc;
+                                               c.seed = qc.seed + static_cast<uint64_t>(i);
+                                               p->rig = assemble_rig(c);
+                                               p->rig.driver->start();
+                                               p->rig.controller->reset();
+                                               p->rig.profile->reset();
+                                               rig.push_back(std::move(p));
+                                             }
+                                             int64_t faults = 0;
+                                             for (auto _ : state) {
+                                               // RigLoop's tick body, for every post.
+                                               for (auto& p : rig) {
+                                                 AssembledRig& r = p->rig;
+                                                 if (!r.driver->read(p->sample)) ++faults;
+                                                 if (r.limits.check(p->sample).code != EventCode::kNone) ++faults;
+                                                 if (p->tick == 0 && r.profile_start_input >= 0) {
+                                                   r.profile->start_from(p->sample.value[static_cast<std::size_t>(r.profile_start_input)]);
+                                                 }
+                                                 const double sp = r.profile->next(static_cast<double>(p->sample.t_ns) * 1e-9);
+                                                 r.controller->update(sp, p->sample, p->command, p->terms);
+                                                 r.driver->write(p->command);
+                                                 if (++p->tick == run_ticks) {
+                                                   // The 20 s step test again, as the plant benchmarks
+                                                   // replay it: a held rig would be cheaper to simulate.
+                                                   r.driver->start();
+                                                   r.controller->reset();
+                                                   r.profile->reset();
+                                                   p->tick = 0;
+                                                 }
+                                               }
+                                             }
+                                             state.counters["faults"] = static_cast<double>(faults);
+                                           })
+                  ->MinTime(min_time)
+                  ->Unit(benchmark::kNanosecond);
+            }
+
+            CollectingReporter reporter;
+            benchmark::RunSpecifiedBenchmarks(&reporter);
+            benchmark::ClearRegisteredBenchmarks();
+
+            Json j = Json::object();
+            j["tool"] = "Google Benchmark " + std::string("(library), MinTime ") + fmt("%.2f", min_time) + " s per benchmark, wall time per iteration";
+            j["period_s"] = T;
+            Json pj = Json::object();
+            Table pt({"plant", "substeps", "us per period", "ns per substep", "of 2.5 ms period", "iterations"});
+            for (const auto& [name, what] : plant_benchmarks) {
+              const auto it = reporter.results.find(name);
+              if (it == reporter.results.end()) continue;
+              const double ns = it->second.ns_per_iteration;
+              Json e = Json::object();
+              e["plant"] = what.first;
+              e["substeps"] = what.second;
+              e["ns_per_period"] = ns;
+              e["ns_per_substep"] = ns / what.second;
+              e["fraction_of_period"] = ns * 1e-9 / T;
+              e["iterations"] = it->second.iterations;
+              pj[name] = e;
+              pt.row({what.first, std::to_string(what.second), fmt("%.2f", ns / 1e3), fmt("%.0f", ns / what.second),
+                      fmt("%.2f%%", 100.0 * ns * 1e-9 / T), std::to_string(it->second.iterations)});
+            }
+            j["plant_advance"] = pj;
+            Json tj = Json::object();
+            Table tt({"actuators", "us per tick", "per actuator us", "of 2.5 ms period", "iterations"});
+            for (const int posts : posts_list) {
+              const std::string name = "tick/actuators:" + std::to_string(posts);
+              const auto it = reporter.results.find(name);
+              if (it == reporter.results.end()) continue;
+              const double ns = it->second.ns_per_iteration;
+              Json e = Json::object();
+              e["actuators"] = posts;
+              e["ns_per_tick"] = ns;
+              e["ns_per_actuator"] = ns / posts;
+              e["fraction_of_period"] = ns * 1e-9 / T;
+              e["iterations"] = it->second.iterations;
+              tj[name] = e;
+              tt.row({std::to_string(posts), fmt("%.2f", ns / 1e3), fmt("%.2f", ns / 1e3 / posts),
+                      fmt("%.2f%%", 100.0 * ns * 1e-9 / T), std::to_string(it->second.iterations)});
+            }
+            j["tick"] = tj;
+            j["tick_what"] = "per actuator: SimDriver read (plant advance one period + sensor models), limit check, demand profile, PI update, DAC write; N quarter-car posts from config/quarter_car.yaml";
+            ctx.out << "  plant advance() per control period:\n" << pt.text("    ")
+                    << "  tick (read to write) against actuators:\n" << tt.text("    ");
+            return j;
+          }};
+}
+
+}  // namespace rigctl::bench

@@ -1,0 +1,89 @@
+// Model-discrepancy diagnosis engine (docs/diagnosis.md sections 4-5):
+// baseline output-error fit on the estimation part, screening of every
+// candidate effect of the rig (short refits, with a start grid for
+// non-convex scalars), full refit of the best few, acceptance on held-out
+// gain + parameter significance + parsimony (BIC with N_eff), greedy
+// addition, a backward check, and `none` when nothing earns its place.
+// Output: the JSON of docs/run-files.md 2.3 and an HTML report.
+#pragma once
+
+#include <map>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "tools/diagnosis/model.hpp"
+
+namespace rigctl::diag {
+
+struct ParamValue {
+  std::string name;
+  std::string unit;
+  double value = 0.0;
+  double sigma = 0.0;
+};
+
+struct CauseResult {
+  std::string cause;
+  double confidence = 0.0;
+  std::string evidence;
+  std::vector<ParamValue> parameters;
+  double baseline_fit_percent = 0.0;  // held-out fit of `signal` before this effect was added
+  double extended_fit_percent = 0.0;  // ... and with it
+  double gain_percent_points = 0.0;
+  std::string signal;
+};
+
+struct ScreenedCandidate {
+  std::string cause;
+  int round = 0;
+  double estimation_cost = 0.0;  // after the short screening fit
+  bool refitted = false;
+  double gain_percent_points = 0.0;  // held-out gain on its best signal (refitted ones)
+  std::string signal;
+  bool accepted = false;
+  std::string reason;  // why it failed (or "accepted")
+};
+
+struct Diagnosis {
+  std::string rig;
+  std::string cause = "none";
+  std::vector<CauseResult> causes;
+  std::map<std::string, double> baseline_fit_percent;
+  std::map<std::string, double> extended_fit_percent;
+  std::string validation;
+  std::vector<ScreenedCandidate> screened;
+  std::vector<ParamValue> baseline_parameters;
+  std::vector<ParamValue> final_parameters;  // baseline + kept effects, refitted jointly
+  std::vector<std::string> stubs;  // cause ids whose candidate is not implemented yet
+  double elapsed_s = 0.0;
+
+  // For the report.
+  std::vector<double> t;
+  std::size_t validation_start = 0;
+  std::vector<std::string> output_names;
+  std::vector<std::vector<double>> measured, y_baseline, y_extended;
+  struct CausePlot {
+    std::string cause, indicator_name, signal;
+    std::vector<double> indicator, residual, effect_term;
+  };
+  std::vector<CausePlot> cause_plots;
+};
+
+struct DiagnoseOptions {
+  double holdout_fraction = 0.2;  // last contiguous block held out
+  double min_gain = 1.0;          // g_min [percentage points]
+  int refit_top = 3;              // K
+  int max_effects = 3;
+  std::ostream* progress = nullptr;  // stderr in the program
+};
+
+Diagnosis diagnose(const RigModel& model, const DiagnoseOptions& options);
+
+// Contract fit percent, 100 (1 - ||y - y_sim|| / ||y - mean(y)||) over [begin, end).
+double fit_percent(const std::vector<double>& y, const std::vector<double>& y_sim, std::size_t begin, std::size_t end);
+
+void write_json(const Diagnosis& d, std::ostream& out);
+void write_report(const Diagnosis& d, std::ostream& out);
+
+}  // namespace rigctl::diag

@@ -1,0 +1,83 @@
+// Model-discrepancy diagnosis: the interface between the engine
+// (tools/diagnosis/engine.*) and one rig's sub-model (tools/diagnosis/rigs.cpp).
+//
+// A rig model holds the measured run and replays it: its simulate() takes
+// one flat parameter vector (the baseline's parameters, then every candidate
+// effect's parameters) and writes the free-run outputs. Each effect's
+// parameters have null values at which the effect vanishes, so the baseline
+// is the full vector with every effect at its null, and a candidate is the
+// baseline with that effect's parameters freed (docs/diagnosis.md 1).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "tools/runfile/run_file.hpp"
+
+namespace rigctl::diag {
+
+struct ParamSpec {
+  std::string name;
+  std::string unit;
+  double init = 0.0;   // start of the fit (the null value for an effect's strength)
+  double lo = -1e30;   // physical bounds
+  double hi = 1e30;
+  double scale = 1.0;  // typical magnitude, for the optimiser's conditioning
+  double null = 0.0;   // value at which the effect vanishes (unused for baseline parameters)
+  std::vector<double> starts;  // extra start values for a non-convex scalar (grid in the screening)
+  bool strength = false;       // the significance test of the effect uses this parameter
+};
+
+struct EffectSpec {
+  std::string cause;  // contract cause id
+  std::vector<ParamSpec> params;
+  std::string description;
+  bool stub = false;  // true: the candidate exists but cannot change the model yet (reported as such)
+};
+
+// One output channel scored by fit percent.
+struct Output {
+  std::string name;  // run-file column, e.g. "x_b"
+  std::vector<double> measured;
+};
+
+class RigModel {
+ public:
+  virtual ~RigModel() = default;
+  virtual std::string rig() const = 0;
+  virtual const std::vector<Output>& outputs() const = 0;
+  virtual const std::vector<double>& time() const = 0;
+  virtual std::vector<ParamSpec> baseline() const = 0;
+  virtual std::vector<EffectSpec> effects() const = 0;
+  // theta: baseline parameters then every effect's, in effects() order.
+  // y: one vector per output, each time().size() long.
+  virtual void simulate(const std::vector<double>& theta, std::vector<std::vector<double>>& y) const = 0;
+  // How the sub-model is replayed (goes into the JSON `validation` string).
+  virtual std::string replay() const = 0;
+  // Samples at the start that no model can match (state initialisation).
+  virtual std::size_t init_window() const { return 20; }
+  // Indicator variable of a cause for the report and the evidence features,
+  // e.g. body velocity for bearing friction. Empty name: none.
+  struct Indicator {
+    std::string name;
+    std::vector<double> values;
+  };
+  virtual Indicator indicator(const std::string& cause) const = 0;
+  // The force (or other) term an effect adds, at parameters theta, along the
+  // record; for the report's "effect curve vs indicator" plot. May be empty.
+  virtual std::vector<double> effect_term(const std::string& /*cause*/, const std::vector<double>& /*theta*/) const {
+    return {};
+  }
+};
+
+struct RigModelOptions {
+  std::string config_path;  // --config, may be empty (nominal parameters)
+  int decimate = 0;         // 0: the rig's default
+};
+
+// Builds the rig's model over a checked run file; throws RunFileError for bad
+// input (missing metadata the replay needs, ...).
+std::unique_ptr<RigModel> make_rig_model(const std::string& rig, const RunFile& run, const RigModelOptions& options);
+
+}  // namespace rigctl::diag

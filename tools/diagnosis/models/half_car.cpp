@@ -1,0 +1,287 @@
+// Diagnosis sub-model of the half car (seed 001, docs/rig-models.md 3):
+// open-loop replay of the measured roads z_r1, z_r2 and the actuator force
+// commands f_1, f_2 through the linear 4-DOF model of plant/half_car/half_car_model.hpp
+// (centre-of-gravity coordinates), outputs z_s, phi, z_u1, z_u2.
+//
+// Replay conventions (what the recorded run holds, checked on a run of
+// `rigctl run config/half_car.yaml --csv`): row k's f_1, f_2 are the forces
+// the controller COMMANDED at t_k (the telemetry's command record; the force
+// acting in the plant is a simulator truth channel and never reaches a run
+// file). The driver holds that command over [t_k, t_k+1) (zero-order hold,
+// as a DAC does), so the replay holds f_k over the period too, and an
+// actuator that does not follow its command shows up as actuator_lag. The
+// roads are displacement transducers sampled at t_k: linear between samples
+// (the road under a wheel is continuous). Absent f columns: passive (0).
+//
+// Baseline: the nominal linear model with the two suspension dampers free
+// (the least certain of the catalogue values, and the term damper_asymmetry
+// must not be confused with a plain damping error). Candidates, one per
+// cause id of the contract, each null at 0:
+//   actuator_lag      F acting = first-order lag tau_a of the command, exact
+//                     under the held command (not the plant's formula: the
+//                     generator's actuator is second order, integrated at
+//                     its sub-steps)
+//   tyre_liftoff      tyre force (1 - w) F + w softplus(F) with F the linear
+//                     total tyre force (static load included): w = 1 cannot
+//                     pull, smoothed over 2 % of the static load (the plant's
+//                     tyre is sharp)
+//   damper_asymmetry  F_d = c_i (1 + a tanh(v / 0.01 m/s)) v: rebound c(1 + a),
+//                     compression c(1 - a) (the plant switches sharply)
+//   sensor_delay      the four outputs read tau late (linear interpolation;
+//                     the simulated driver interpolates cubically)
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <filesystem>
+
+#include "config/rig_config.hpp"
+#include "plant/half_car/half_car_params.hpp"
+#include "tools/diagnosis/rigs.hpp"
+#include "tools/diagnosis/util.hpp"
+
+namespace rigctl::diag {
+
+namespace {
+
+// Smooth max(0, x) over a band eps, overflow-safe.
+double softplus(double x, double eps) {
+  const double z = x / eps;
+  if (z > 40.0) return x;  // exp(-40) = 4e-18: x to double precision (the common case: tyre loaded)
+  return z > 0.0 ? x + eps * std::log1p(std::exp(-z)) : eps * std::log1p(std::exp(z));
+}
+
+constexpr double kRateBand = 0.01;      // [m/s] tanh band of the asymmetric damper (as quarter_car's)
+constexpr double kTyreBand = 0.02;      // softplus band of the tyre, share of the static load
+constexpr int kSubsteps = 2;            // RK4 at 1.25 ms: wheel hop (~10 Hz) at omega h = 0.08
+
+class HalfCarDiagModel : public RigModel {
+ public:
+  HalfCarDiagModel(const RunFile& run, const RigModelOptions& o) {
+    p_ = load_params(o.config_path);
+    const int dec = std::max(1, o.decimate);
+    decimate_ = dec;
+    const bool has_f = run.has("f_1") && run.has("f_2");
+    if (run.has("f_1") != run.has("f_2"))
+      throw RunFileError("half_car: f_1 and f_2 come together (both columns or neither)");
+    active_ = has_f;
+    const char* names[4] = {"z_s", "phi", "z_u1", "z_u2"};
+    std::vector<std::vector<double>> meas(4);
+    const std::size_t step = static_cast<std::size_t>(dec);
+    for (std::size_t i = 0; i < run.size(); i += step) {
+      t_.push_back(run.t[i]);
+      zr_[0].push_back(run.col("z_r1")[i]);
+      zr_[1].push_back(run.col("z_r2")[i]);
+      // A held command over a decimated period: the mean of the commands held in it.
+      for (std::size_t w = 0; w < 2; ++w) {
+        double sum = 0.0;
+        const std::size_t end = std::min(run.size(), i + step);
+        if (has_f)
+          for (std::size_t j = i; j < end; ++j) sum += run.col(w == 0 ? "f_1" : "f_2")[j];
+        f_[w].push_back(sum / static_cast<double>(end - i));
+      }
+      for (std::size_t c = 0; c < 4; ++c) meas[c].push_back(run.col(names[c])[i]);
+    }
+    dt_ = run.dt * dec;
+    for (std::size_t c = 0; c < 4; ++c) outputs_.push_back({names[c], meas[c]});
+    lever_[0] = half_car_lever_arm(p_, 0);
+    lever_[1] = half_car_lever_arm(p_, 1);
+    static_load_[0] = half_car_static_tyre_load(p_, 0);
+    static_load_[1] = half_car_static_tyre_load(p_, 1);
+    m_roll_full_ = half_car_roll_moment(p_);
+    // Initial state: a least-squares line through the first samples (position
+    // and slope), so that sensor noise does not set a velocity.
+    const std::size_t m = std::min<std::size_t>(8, t_.size());
+    for (std::size_t c = 0; c < 4; ++c) {
+      double st = 0, sy = 0, stt = 0, sty = 0;
+      for (std::size_t i = 0; i < m; ++i) {
+        const double tt = static_cast<double>(i) * dt_, y = meas[c][i];
+        st += tt, sy += y, stt += tt * tt, sty += tt * y;
+      }
+      const double den = static_cast<double>(m) * stt - st * st;
+      const double slope = den > 0 ? (static_cast<double>(m) * sty - st * sy) / den : 0.0;
+      x0_[c] = (sy - slope * st) / static_cast<double>(m);
+      v0_[c] = slope;
+    }
+    // Indicators from the measured signals.
+    rate1_.resize(t_.size());
+    for (std::size_t i = 0; i < t_.size(); ++i) rate1_[i] = meas[0][i] + lever_[0] * meas[1][i] - meas[2][i];
+    rate1_ = central_diff(rate1_, dt_);
+    vu1_ = central_diff(meas[2], dt_);
+    df1_ = central_diff(f_[0], dt_);
+    load_.resize(t_.size());
+    const double kt[2] = {p_.tyre_stiffness_1, p_.tyre_stiffness_2};
+    for (std::size_t i = 0; i < t_.size(); ++i) {
+      double lo = 1e9;
+      for (std::size_t w = 0; w < 2; ++w)
+        lo = std::min(lo, (static_load_[w] + kt[w] * (zr_[w][i] - meas[2 + w][i])) / static_load_[w]);
+      load_[i] = lo;
+    }
+  }
+
+  std::string rig() const override { return "half_car"; }
+  const std::vector<Output>& outputs() const override { return outputs_; }
+  const std::vector<double>& time() const override { return t_; }
+  std::vector<ParamSpec> baseline() const override {
+    return {P("c_1", "N s/m", p_.damper_1, 0.0, 1e5, std::max(100.0, p_.damper_1)),
+            P("c_2", "N s/m", p_.damper_2, 0.0, 1e5, std::max(100.0, p_.damper_2))};
+  }
+  std::vector<EffectSpec> effects() const override {
+    // Start grids: the lag and the delay are non-convex scalars; a second start
+    // a few times larger covers strong effects (docs/diagnosis.md 4).
+    return {
+        {"actuator_lag", {P("tau_a", "s", 0.005, 0.0, 0.2, 0.01, 0.0, true, {0.025})},
+         "the active force follows its command through a first-order lag tau_a"},
+        {"tyre_liftoff", {P("unilateral", "1", 0.5, 0.0, 1.0, 1.0, 0.0, true)},
+         "the tyre cannot pull: contact force softplus(F) blended by `unilateral` (1: leaves the ground)"},
+        {"damper_asymmetry", {P("asym", "1", 0.0, -0.95, 0.95, 0.1, 0.0, true)},
+         "rebound and compression damping differ: c (1 + asym tanh(v_rel / 0.01 m/s)), i.e. "
+         "c_reb / c_comp = (1 + asym) / (1 - asym)"},
+        {"sensor_delay", {P("tau", "s", 0.002, 0.0, 0.05, 0.002, 0.0, true, {0.008})},
+         "z_s, phi, z_u1, z_u2 measured late by tau"},
+    };
+  }
+  std::string replay() const override {
+    return std::string("open-loop replay of the 4-DOF half car: measured z_r1, z_r2 (linear between samples) and ") +
+           (active_ ? "commanded actuator forces f_1, f_2 (held over each period, as the DAC does)"
+                    : "no actuator forces (passive: no f_1, f_2 columns)") +
+           " drive the linear model; RK4, " + std::to_string(kSubsteps) + " sub-steps per " +
+           std::to_string(static_cast<int>(std::lround(dt_ * 1e6))) + " us sample" +
+           (decimate_ > 1 ? " (decimated by " + std::to_string(decimate_) + ")" : "");
+  }
+
+  void simulate(const std::vector<double>& th, std::vector<std::vector<double>>& y) const override {
+    const double c[2] = {th[0], th[1]};
+    const double tau_a = th[2], uni = th[3], asym = th[4], tau_s = th[5];
+    const std::size_t n = t_.size();
+    y.assign(4, std::vector<double>(n, 0.0));
+    const double k[2] = {p_.spring_1, p_.spring_2};
+    const double kt[2] = {p_.tyre_stiffness_1, p_.tyre_stiffness_2};
+    const double ct[2] = {p_.tyre_damping_1, p_.tyre_damping_2};
+    const double mu[2] = {p_.mass_unsprung_1, p_.mass_unsprung_2};
+    const double eps[2] = {kTyreBand * static_load_[0], kTyreBand * static_load_[1]};
+    const double h = dt_ / kSubsteps;
+    const double decay_h = tau_a > 1e-6 ? std::exp(-0.5 * h / tau_a) : 0.0;  // lag over half a sub-step
+    // q = [z_s, phi, z_u1, z_u2, v_s, omega, v_u1, v_u2]
+    std::array<double, 8> q{x0_[0], x0_[1], x0_[2], x0_[3], v0_[0], v0_[1], v0_[2], v0_[3]};
+    double fa[2] = {f_[0][0], f_[1][0]};  // force acting (lag state)
+    auto deriv = [&](const std::array<double, 8>& s, const double zr[2], const double vr[2], const double fact[2],
+                     double m_roll, std::array<double, 8>& d) {
+      double heave = 0.0, moment = m_roll;
+      for (std::size_t w = 0; w < 2; ++w) {
+        const double l = lever_[w];
+        const double travel = s[0] + l * s[1] - s[2 + w];
+        const double rate = s[4] + l * s[5] - s[6 + w];
+        const double damp = c[w] * (1.0 + (asym != 0.0 ? asym * std::tanh(rate / kRateBand) : 0.0)) * rate;
+        const double fb = -k[w] * travel - damp + fact[w];
+        heave += fb;
+        moment += l * fb;
+        const double ft = static_load_[w] + kt[w] * (zr[w] - s[2 + w]) + ct[w] * (vr[w] - s[6 + w]);
+        const double fe = uni > 0.0 ? (1.0 - uni) * ft + uni * softplus(ft, eps[w]) : ft;
+        d[2 + w] = s[6 + w];
+        d[6 + w] = (fe - static_load_[w] - fb) / mu[w];
+      }
+      d[0] = s[4];
+      d[1] = s[5];
+      d[4] = heave / p_.mass_body;
+      d[5] = moment / p_.inertia_body;
+    };
+    std::array<double, 8> k1, k2, k3, k4, s;
+    for (std::size_t i = 0; i < n; ++i) {
+      for (std::size_t c4 = 0; c4 < 4; ++c4) y[c4][i] = q[c4];
+      if (i + 1 == n) break;
+      double vr[2], zr0[2];
+      for (std::size_t w = 0; w < 2; ++w) {
+        zr0[w] = zr_[w][i];
+        vr[w] = (zr_[w][i + 1] - zr_[w][i]) / dt_;
+      }
+      const double u[2] = {f_[0][i], f_[1][i]};
+      for (int sub = 0; sub < kSubsteps; ++sub) {
+        const double t0 = t_[i] + sub * h;
+        const double a0 = sub * h;  // time into the period
+        double zr_a[2], zr_b[2], zr_c[2], f_a[2], f_b[2], f_c[2];
+        for (std::size_t w = 0; w < 2; ++w) {
+          zr_a[w] = zr0[w] + vr[w] * a0;
+          zr_b[w] = zr0[w] + vr[w] * (a0 + 0.5 * h);
+          zr_c[w] = zr0[w] + vr[w] * (a0 + h);
+          // Exact first-order lag under the held command at the stage times.
+          f_a[w] = fa[w];
+          f_b[w] = tau_a > 1e-6 ? u[w] + (fa[w] - u[w]) * decay_h : u[w];
+          f_c[w] = tau_a > 1e-6 ? u[w] + (fa[w] - u[w]) * decay_h * decay_h : u[w];
+        }
+        const double m0 = roll_moment(t0), m1 = roll_moment(t0 + 0.5 * h), m2 = roll_moment(t0 + h);
+        deriv(q, zr_a, vr, f_a, m0, k1);
+        for (std::size_t j = 0; j < 8; ++j) s[j] = q[j] + 0.5 * h * k1[j];
+        deriv(s, zr_b, vr, f_b, m1, k2);
+        for (std::size_t j = 0; j < 8; ++j) s[j] = q[j] + 0.5 * h * k2[j];
+        deriv(s, zr_b, vr, f_b, m1, k3);
+        for (std::size_t j = 0; j < 8; ++j) s[j] = q[j] + h * k3[j];
+        deriv(s, zr_c, vr, f_c, m2, k4);
+        for (std::size_t j = 0; j < 8; ++j) q[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]);
+        for (std::size_t w = 0; w < 2; ++w) fa[w] = f_c[w];
+      }
+      if (!std::isfinite(q[0]) || !std::isfinite(q[2]) || !std::isfinite(q[3]) || std::abs(q[0]) > 10.0) {
+        for (std::size_t j = i + 1; j < n; ++j)
+          for (std::size_t c4 = 0; c4 < 4; ++c4) y[c4][j] = 1e3;
+        return;
+      }
+    }
+    for (auto& yc : y) delay(yc, tau_s, dt_);
+  }
+
+  Indicator indicator(const std::string& cause) const override {
+    if (cause == "actuator_lag") return {"df_1/dt, commanded [N/s]", df1_};
+    if (cause == "tyre_liftoff") return {"lower tyre load / static load (from measured z_r - z_u)", load_};
+    if (cause == "damper_asymmetry") return {"corner-1 suspension rate [m/s] (from measured)", rate1_};
+    if (cause == "sensor_delay") return {"dz_u1/dt [m/s]", vu1_};
+    return {};
+  }
+  std::vector<double> effect_term(const std::string& cause, const std::vector<double>& th) const override {
+    if (cause != "damper_asymmetry") return {};
+    // Extra corner-1 damper force at the measured rate, over the spring rate:
+    // a displacement-equivalent [m] so that it shares the residual's axis.
+    std::vector<double> out(rate1_.size());
+    for (std::size_t i = 0; i < out.size(); ++i)
+      out[i] = th[0] * th[4] * std::tanh(rate1_[i] / kRateBand) * rate1_[i] / p_.spring_1;
+    return out;
+  }
+
+ private:
+  static HalfCarParams load_params(const std::string& path) {
+    // --config, else the shipped config when run from the source tree, else
+    // the built-in defaults (the same nominal pitch-plane set).
+    std::string file = path;
+    if (file.empty() && std::filesystem::exists("config/half_car.yaml")) file = "config/half_car.yaml";
+    if (file.empty()) return HalfCarParams{};
+    const auto cfg = load_rig_config(file);
+    if (cfg.rig != "half_car") throw RunFileError("--config is a '" + cfg.rig + "' config, not half_car");
+    return cfg.half_car;
+  }
+  // Centrifugal roll moment of the config's curve (roll plane): a known input.
+  double roll_moment(double t) const {
+    if (m_roll_full_ == 0.0) return 0.0;
+    const double since = t - p_.curve_start_time;
+    if (since < 0.0) return 0.0;
+    if (p_.curve_ramp_time > 0.0 && since < p_.curve_ramp_time) return m_roll_full_ * since / p_.curve_ramp_time;
+    return m_roll_full_;
+  }
+
+  HalfCarParams p_;
+  double m_roll_full_ = 0.0;
+  std::vector<double> t_;
+  std::array<std::vector<double>, 2> zr_, f_;
+  double dt_ = 0.0;
+  int decimate_ = 1;
+  bool active_ = false;
+  double lever_[2] = {0, 0}, static_load_[2] = {0, 0};
+  double x0_[4] = {0, 0, 0, 0}, v0_[4] = {0, 0, 0, 0};
+  std::vector<double> rate1_, vu1_, df1_, load_;
+  std::vector<Output> outputs_;
+};
+
+}  // namespace
+
+std::unique_ptr<RigModel> make_half_car_model(const RunFile& run, const RigModelOptions& options) {
+  return std::make_unique<HalfCarDiagModel>(run, options);
+}
+
+}  // namespace rigctl::diag

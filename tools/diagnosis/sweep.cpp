@@ -1,0 +1,137 @@
+#include "tools/diagnosis/sweep.hpp"
+
+#include <chrono>
+#include <filesystem>
+#include <iomanip>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include "tools/diagnosis/engine.hpp"
+#include "tools/diagnosis/model.hpp"
+#include "tools/hidden_effects/make_run.hpp"
+#include "tools/runfile/run_file.hpp"
+
+namespace rigctl {
+
+namespace {
+
+struct Job {
+  std::string truth;  // cause id or "none"
+  double level = 0.0;
+  int seed = 1;
+};
+
+std::string level_name(double level) {
+  if (level == 0.0) return "clean";
+  if (level == weak_level()) return "weak";
+  if (level == 1.0) return "strong";
+  std::ostringstream s;
+  s << level;
+  return s.str();
+}
+
+}  // namespace
+
+SweepResult run_sweep(const SweepOptions& o, const std::atomic<bool>& stop, std::ostream& progress) {
+  const RigEffectGenerator& gen = effect_generator(o.rig);
+  SweepResult r;
+  r.labels.push_back("none");
+  for (const auto& c : gen.causes) r.labels.push_back(c);
+  std::vector<Job> jobs;
+  for (int k = 0; k < o.clean_runs; ++k) jobs.push_back({"none", 0.0, 100 + k});
+  for (const auto& c : o.causes.empty() ? gen.causes : o.causes)
+    for (double level : o.levels)
+      for (int seed : o.seeds) jobs.push_back({c, level, seed});
+
+  const std::string dir = o.scratch_dir.empty()
+                              ? (std::filesystem::temp_directory_path() / ("rigctl_sweep_" + std::to_string(getpid())))
+                                    .string()
+                              : o.scratch_dir;
+  std::filesystem::create_directories(dir);
+  std::mutex m;
+  std::size_t next = 0, done = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  auto worker = [&] {
+    for (;;) {
+      std::size_t i;
+      {
+        std::lock_guard<std::mutex> lock(m);
+        if (next >= jobs.size() || stop.load()) return;
+        i = next++;
+      }
+      const Job& j = jobs[i];
+      SweepCell cell{j.truth, level_name(j.level), "error", 0.0, 0.0};
+      const auto start = std::chrono::steady_clock::now();
+      try {
+        MakeRunOptions mr;
+        mr.rig = o.rig;
+        mr.config_path = o.config_path;
+        if (j.truth != "none") mr.effects.emplace_back(j.truth, j.level);
+        mr.seed = j.seed;
+        mr.duration_s = o.duration_s;
+        mr.out_csv = dir + "/run-" + std::to_string(i) + ".csv";
+        std::ostringstream quiet;
+        make_run(mr, quiet);
+        const auto rf = read_run_file(mr.out_csv, run_file_columns(o.rig));
+        const auto model = diag::make_rig_model(o.rig, rf, {});
+        const auto d = diag::diagnose(*model, {});
+        cell.named = d.cause;
+        if (!d.causes.empty()) cell.gain = d.causes.front().gain_percent_points;
+        std::filesystem::remove(mr.out_csv);
+      } catch (const std::exception& e) {
+        cell.named = "error";
+        progress << "  " << j.truth << " " << level_name(j.level) << " seed " << j.seed << ": " << e.what() << "\n";
+      }
+      cell.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      std::lock_guard<std::mutex> lock(m);
+      r.cells.push_back(cell);
+      ++done;
+      progress << "  [" << done << "/" << jobs.size() << "] " << cell.truth << " (" << cell.level << ") -> "
+               << cell.named << (cell.named == cell.truth ? "" : "   <-- wrong") << "  " << std::fixed
+               << std::setprecision(1) << cell.seconds << " s\n";
+      progress.flush();
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int k = 0; k < std::max(1, o.threads); ++k) pool.emplace_back(worker);
+  for (auto& t : pool) t.join();
+  if (o.scratch_dir.empty()) std::filesystem::remove_all(dir);
+  r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  for (const auto& c : r.cells) {
+    ++r.confusion[c.truth][c.named];
+    ++r.total;
+    if (c.named == c.truth) ++r.correct;
+  }
+  return r;
+}
+
+void write_confusion_markdown(const SweepResult& r, std::ostream& out) {
+  std::vector<std::string> cols = r.labels;
+  bool errors = false;
+  for (const auto& [t, row] : r.confusion)
+    if (row.count("error")) errors = true;
+  if (errors) cols.push_back("error");
+  out << "| true \\ named |";
+  for (const auto& c : cols) out << " " << c << " |";
+  out << " accuracy |\n|---|";
+  for (std::size_t i = 0; i < cols.size(); ++i) out << "---:|";
+  out << "---:|\n";
+  for (const auto& t : r.labels) {
+    const auto it = r.confusion.find(t);
+    if (it == r.confusion.end()) continue;
+    int n = 0;
+    for (const auto& [named, k] : it->second) n += k;
+    out << "| " << t << " |";
+    for (const auto& c : cols) {
+      const auto k = it->second.count(c) ? it->second.at(c) : 0;
+      out << " " << (k ? (c == t ? "**" + std::to_string(k) + "**" : std::to_string(k)) : "") << " |";
+    }
+    const int ok = it->second.count(t) ? it->second.at(t) : 0;
+    out << " " << ok << "/" << n << " |\n";
+  }
+  out << "\nAccuracy " << r.correct << "/" << r.total << " (" << std::fixed << std::setprecision(1)
+      << (r.total ? 100.0 * r.correct / r.total : 0.0) << " %), " << std::setprecision(0) << r.wall_s << " s wall.\n";
+}
+
+}  // namespace rigctl

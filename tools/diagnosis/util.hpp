@@ -1,0 +1,65 @@
+// Small numerical helpers shared by the diagnosis sub-models (tools/diagnosis/models/*.cpp).
+#pragma once
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "tools/diagnosis/model.hpp"
+
+namespace rigctl::diag {
+
+inline std::vector<double> central_diff(const std::vector<double>& x, double dt) {
+  const std::size_t n = x.size();
+  std::vector<double> v(n, 0.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t a = i == 0 ? 0 : i - 1, b = i + 1 < n ? i + 1 : n - 1;
+    v[i] = b > a ? (x[b] - x[a]) / (static_cast<double>(b - a) * dt) : 0.0;
+  }
+  return v;
+}
+
+// Value of a uniformly sampled series at fractional sample position s (clamped).
+inline double at(const std::vector<double>& y, double s) {
+  if (s <= 0.0) return y.front();
+  const double last = static_cast<double>(y.size() - 1);
+  if (s >= last) return y.back();
+  const auto i = static_cast<std::size_t>(s);
+  const double a = s - static_cast<double>(i);
+  return y[i] + a * (y[i + 1] - y[i]);
+}
+
+// Delays a series by tau (linear interpolation), holding the first value before the start.
+inline void delay(std::vector<double>& y, double tau, double dt) {
+  if (tau <= 0.0) return;
+  const std::vector<double> src = y;
+  const double shift = tau / dt;
+  for (std::size_t i = 0; i < y.size(); ++i) y[i] = at(src, static_cast<double>(i) - shift);
+}
+
+// Implicit (Moreau) velocity update of a mass with viscous and Coulomb
+// friction under force f over a step h: sticks exactly, never chatters.
+// cp, cn >= 0: Coulomb levels for positive and negative motion; dp, dn >= 0 viscous.
+inline double implicit_velocity(double m, double v, double f, double h, double cp, double cn, double dp, double dn) {
+  const double a = m * v + h * f;
+  if (a > h * cp) return (a - h * cp) / (m + h * dp);
+  if (a < -h * cn) return (a + h * cn) / (m + h * dn);
+  return 0.0;
+}
+
+inline ParamSpec P(const std::string& name, const std::string& unit, double init, double lo, double hi, double scale,
+            double null = 0.0, bool strength = false, std::vector<double> starts = {}) {
+  ParamSpec p;
+  p.name = name;
+  p.unit = unit;
+  p.init = init;
+  p.lo = lo;
+  p.hi = hi;
+  p.scale = scale;
+  p.null = null;
+  p.strength = strength;
+  p.starts = std::move(starts);
+  return p;
+}
+
+}  // namespace rigctl::diag

@@ -1,0 +1,250 @@
+#include "tools/run/run_command.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <filesystem>
+#include <iomanip>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "config/config_reader.hpp"
+#include "config/rig_config.hpp"
+#include "drivers/sim/sim_driver.hpp"
+#include "rt/comms/event_log.hpp"
+#include "rt/realtime.hpp"
+#include "rt/comms/telemetry_publisher.hpp"
+#include "tools/run/console_status.hpp"
+#include "tools/runfile/log2csv.hpp"
+#include "tools/run/loop_heartbeat.hpp"
+#include "tools/run/operator_mode.hpp"
+#include "tools/run/rig_assembly.hpp"
+#include "tools/run/service_notify.hpp"
+
+namespace rigctl {
+
+namespace {
+
+int64_t wall_utime_now() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+std::string default_log_path(const std::string& dir, const std::string& rig) {
+  const std::time_t now = std::time(nullptr);
+  std::tm tm{};
+  localtime_r(&now, &tm);
+  std::ostringstream name;
+  name << rig << "-" << std::put_time(&tm, "%Y%m%d-%H%M%S") << ".lcm";
+  std::filesystem::path p = std::filesystem::path(dir) / name.str();
+  // Two runs in the same second must not overwrite each other.
+  for (int i = 2; std::filesystem::exists(p); ++i) {
+    p = std::filesystem::path(dir) / (name.str().substr(0, name.str().size() - 4) + "-" + std::to_string(i) + ".lcm");
+  }
+  return p.string();
+}
+
+std::string describe(const DistributionSummary& d) {
+  std::ostringstream os;
+  os << std::fixed << std::setprecision(1) << "p50 " << d.p50_ns / 1e3 << " us, p99 " << d.p99_ns / 1e3
+     << " us, p99.9 " << d.p999_ns / 1e3 << " us, max " << d.max_ns / 1e3 << " us";
+  return os.str();
+}
+
+}  // namespace
+
+RunReport run_rig(const RunOptions& options, const std::atomic<bool>& stop, std::ostream& out) {
+  return run_rig(load_rig_config(options.config_path, options.case_name), options, stop, out);
+}
+
+RunReport run_rig(const RigConfig& config, const RunOptions& options, const std::atomic<bool>& stop, std::ostream& out) {
+  AssembledRig rig = assemble_rig(config);
+  if (options.fast && !rig.driver->simulated()) {
+    throw std::runtime_error("--fast needs a simulated driver: '" + config.driver + "' runs real hardware in real time");
+  }
+  // Injected faults (drivers/sim/sim_faults.hpp): the config's `faults:`, then --fault.
+  std::vector<FaultSpec> faults = config.faults;
+  faults.insert(faults.end(), options.faults.begin(), options.faults.end());
+  auto* sim = dynamic_cast<SimDriver*>(rig.driver.get());
+  if (!faults.empty()) {
+    if (sim == nullptr) {
+      throw std::runtime_error("faults are injected by the simulated driver (driver: sim); on the wire use `rigctl rig-sim --fault`");
+    }
+    sim->set_faults(faults);
+  }
+
+  OperatorModeOptions op;
+  op.force = options.operator_mode;
+  op.key_path = options.key_path;
+  const bool operator_run = operator_mode(config, op);
+  if (operator_run) rig.safety.auto_sequence = false;  // --operator overrides the file
+  // Operator mode runs until the operator ends it (stop, then hydraulics off)
+  // or a signal, unless --duration bounds it.
+  const bool unbounded = operator_run && !options.duration_s;
+  const double duration = options.duration_s.value_or(unbounded ? 0.0 : rig.profile_duration_s);
+  if (!unbounded && !(duration > 0.0)) throw std::runtime_error("run duration must be positive");
+  LoopOptions loop_options;
+  loop_options.period_ns = std::llround(config.loop.period_s * 1e9);
+  loop_options.overrun_policy = config.loop.overrun_policy;
+  loop_options.max_ticks = unbounded ? std::numeric_limits<int64_t>::max() : std::llround(duration / config.loop.period_s);
+  loop_options.start_from_input = rig.profile_start_input;
+  loop_options.timing_every_ticks = std::max<int64_t>(1, std::llround(config.loop.timing_publish_s / config.loop.period_s));
+
+  RunReport report;
+  report.log_path = options.log_path.empty() ? default_log_path(config.telemetry.log_dir, config.rig) : options.log_path;
+  report.csv_path = options.csv_path;
+
+  TelemetryMeta meta;
+  meta.rig = config.rig;
+  meta.layout = rig.driver->layout();
+  meta.setpoint_name = rig.setpoint_name;
+  meta.controller_name = rig.controller->name();
+  meta.term_names = rig.controller->term_names();
+  meta.channel_prefix = config.telemetry.channel_prefix;
+  meta.overrun_policy = std::string(to_string(config.loop.overrun_policy));
+  meta.period_ns = loop_options.period_ns;
+  meta.start_utime = wall_utime_now();
+  // Simulated time has no deadline to keep: a full queue holds the loop back
+  // instead of losing records (rt/queue_full_policy.hpp).
+  meta.queue_policy = options.fast ? QueueFullPolicy::kWait : QueueFullPolicy::kDrop;
+  const std::string url = options.lcm_url.empty() ? config.telemetry.lcm_url : options.lcm_url;
+  // Ten seconds of records: a paced run's publisher thread would have to
+  // stall that long before the loop drops telemetry.
+  const auto queue_capacity = options.telemetry_queue_records > 0
+                                  ? options.telemetry_queue_records
+                                  : static_cast<std::size_t>(10.0 / config.loop.period_s);
+  TelemetryPublisher publisher(meta, url, report.log_path, queue_capacity);
+  Driver* driver = rig.driver.get();
+  publisher.set_diagnostics_source([driver] { return driver->diagnostics(); }, config.driver);
+
+  // The event log: every state change, trip and command, fsync'd per line.
+  report.events_path = options.events_path.empty() ? report.log_path + ".events" : options.events_path;
+  EventLog events(report.events_path, EventLogMeta{config.rig, rig.driver->layout(), meta.start_utime, meta.queue_policy});
+  events.set_failure_handler([&publisher](const std::string& text) {
+    spdlog::error("{}", text);
+    publisher.report_event("log_write_failed", text);
+  });
+  std::unique_ptr<CommandReceiver> receiver;
+  SpscQueue<OperatorCommand>* commands = options.operator_commands;
+  if (operator_run && commands == nullptr) {
+    op.lcm_url = url;
+    const auto feedback = static_cast<std::size_t>(std::max(0, rig.safety.feedback_input));
+    const auto& inputs = rig.driver->layout().inputs;
+    op.setpoint_unit = feedback < inputs.size() ? inputs[feedback].unit : "";
+    receiver = make_operator_receiver(config, op, events);
+    commands = &receiver->queue();
+  }
+  // Counts the loop's ticks for the systemd watchdog (a no-op outside systemd).
+  LoopHeartbeat heartbeat(publisher);
+  ServiceNotifier notifier(heartbeat.beats());
+
+  rig.driver->start();
+  publisher.start();  // before the real-time set-up: the publisher keeps normal priority
+  events.start();
+  // Threads started before the RealtimeSession keep normal priority.
+  if (receiver) receiver->start();
+  notifier.start();
+
+  out << "rigctl run: " << config.rig << " (" << config.driver << " driver) from " << options.config_path
+      << (options.case_name.empty() ? "" : " case " + options.case_name) << ", "
+      << (unbounded ? std::string("until stopped") : fmt::format("{:g} s", duration)) << " "
+      << (options.fast ? "as fast as possible" : "paced by the real clock") << "\n"
+      << "  telemetry: " << url << " channels " << config.telemetry.channel_prefix << "*, a full queue "
+      << (meta.queue_policy == QueueFullPolicy::kWait ? "holds the loop back (simulated time: nothing is dropped)"
+                                                       : "drops and counts (the tick never waits)")
+      << "\n";
+  if (receiver) {
+    out << "  operator mode: the rig powers up faulted; commands on " << receiver->channel() << " (acks on "
+        << receiver->ack_channel() << ")\n";
+  }
+  out.flush();
+
+  MonotonicClock monotonic;
+  VirtualClock virtual_clock;
+  LoopClock& clock = options.fast ? static_cast<LoopClock&>(virtual_clock) : monotonic;
+  if (sim != nullptr) sim->set_stall_clock(&clock);  // an overrun fault stalls the loop's own clock
+
+  const auto wall_start = std::chrono::steady_clock::now();
+  LoopResult result;
+  {
+    // A --fast run is not paced, so real-time scheduling would only starve
+    // the machine; it is skipped without a warning.
+    RealtimeConfig rt = config.loop.realtime;
+    rt.enabled = rt.enabled && options.realtime;
+    std::optional<RealtimeSession> session;
+    if (!options.fast) {
+      session.emplace(rt);
+      for (const auto& w : session->warnings()) spdlog::warn("{}", w);
+    }
+    std::optional<ConsoleStatus> status;
+    if (!options.fast) {
+      status.emplace(publisher, meta, rig.driver->layout().input_index(config.controller.feedback),
+                   unbounded ? std::numeric_limits<double>::infinity() : duration, out);
+    }
+    RigLoop loop(*rig.driver, *rig.controller, *rig.profile, rig.detectors, heartbeat, clock, loop_options,
+                 rig.safety);
+    loop.set_event_sink(&events);
+    loop.set_operator_commands(commands);
+    try {
+      result = loop.run(stop);
+    } catch (...) {
+      notifier.stop("control loop failed");
+      if (receiver) receiver->stop();
+      events.stop();
+      publisher.stop();  // keep what was recorded
+      rig.driver->stop();
+      throw;
+    }
+  }
+  report.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  notifier.stop("control loop ended, closing the logs");
+  if (receiver) receiver->stop();  // before the event log closes: its last rejections go in
+  events.stop();
+  publisher.stop();
+  rig.driver->stop();
+  result.dropped_records = publisher.dropped();
+  report.loop = result;
+
+  const auto& t = result.timing;
+  out << "  ended: " << to_string(result.final_state) << " (" << to_string(result.end_event.code);
+  if (result.end_event.channel >= 0) {
+    // Valve saturation names an output; every other trip an input.
+    const auto& channels =
+        result.end_event.code == EventCode::kValveSaturated ? meta.layout.outputs : meta.layout.inputs;
+    const auto index = static_cast<std::size_t>(result.end_event.channel);
+    out << ": " << (index < channels.size() ? channels[index].name : "?") << " = " << result.end_event.value;
+  }
+  out << ") after " << result.ticks << " ticks ("
+      << std::fixed << std::setprecision(3) << static_cast<double>(result.ticks) * config.loop.period_s
+      << " s rig time, " << report.wall_s << " s wall), rig state " << to_string(result.final_safety_state) << "\n";
+  if (!options.fast) {
+    out << "  wake-up latency: " << describe(t.wakeup_latency) << "\n"
+        << "  compute per tick: " << describe(t.compute) << "\n"
+        << (rig.driver->io_latency().count > 0 ? "  I/O round trip: " + describe(rig.driver->io_latency()) + "\n" : "")
+        << "  overruns: " << t.overruns << " (missed ticks " << t.missed_ticks << ", policy "
+        << to_string(config.loop.overrun_policy) << ")\n";
+  }
+  if (report.loop.dropped_records > 0) out << "  telemetry records dropped: " << report.loop.dropped_records << "\n";
+  if (publisher.queue_waits() > 0) {
+    out << "  telemetry queue full " << publisher.queue_waits() << " times: the loop waited for the publisher\n";
+  }
+  out << "  log: " << report.log_path << "\n";
+  const EventLogStats es = events.stats();
+  out << "  events: " << report.events_path << " (" << es.written << " lines, " << std::setprecision(2)
+      << "longest write+fsync " << es.max_fsync_ms << " ms" << (es.pending > 0 ? ", " + std::to_string(es.pending) + " NOT WRITTEN" : "")
+      << ")\n";
+  if (receiver) out << "  operator commands: " << describe_counters(receiver->counters()) << "\n";
+  if (publisher.log_failures() > 0) out << "  run log write failures: " << publisher.log_failures() << "\n";
+  if (!report.csv_path.empty()) {
+    const auto csv =
+        log_to_csv(report.log_path, report.csv_path, config.telemetry.channel_prefix, options.csv_truth_channels);
+    out << "  csv: " << report.csv_path << " (" << csv.rows << " rows)\n";
+  }
+  out.flush();
+  return report;
+}
+
+}  // namespace rigctl

@@ -1,0 +1,56 @@
+// `rigctl run`: load a config, assemble the rig, run the loop with telemetry
+// and a run log, report.
+#pragma once
+
+#include <atomic>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "config/rig_config.hpp"
+#include "rt/loop/rig_loop.hpp"
+#include "drivers/sim/fault_spec.hpp"
+
+namespace rigctl {
+
+struct RunOptions {
+  std::string config_path;
+  std::string case_name;             // a `cases:` entry of the config, "" for none
+  std::optional<double> duration_s;  // default: the profile's length; operator mode: until the operator ends it
+  bool fast = false;                 // simulated plant only: no pacing
+  // Telemetry records the loop can hand over before the queue is full;
+  // 0: ten seconds of ticks. A small queue shows the full-queue policy at work.
+  std::size_t telemetry_queue_records = 0;
+  std::string log_path;              // default: <log_dir>/<rig>-<time>.lcm
+  std::string events_path;           // event log; default: <log_path>.events
+  std::string csv_path;              // optional run-file CSV
+  bool csv_truth_channels = true;    // the simulator's sim_* channels in the CSV too
+  std::string lcm_url;               // overrides telemetry.lcm_url
+  bool realtime = true;              // false: skip mlockall/SCHED_FIFO (tests)
+  // Operator commands from a caller's own source (tests); nullptr: in
+  // operator mode run_rig opens the LCM command receiver itself
+  // (tools/run/operator_mode.hpp). The rig then moves only on these.
+  SpscQueue<OperatorCommand>* operator_commands = nullptr;
+  bool operator_mode = false;  // --operator: safety.auto_sequence taken as false
+  std::string key_path;        // --key: overrides operator.key_file
+  // --fault KIND@TIME[:ARG...], after the config's `faults:`; simulated driver only (drivers/sim/sim_faults.hpp).
+  std::vector<FaultSpec> faults;
+};
+
+struct RunReport {
+  LoopResult loop;
+  std::string log_path;
+  std::string csv_path;
+  std::string events_path;
+  double wall_s = 0.0;
+};
+
+// Throws ConfigError or std::runtime_error with a clear message; `stop`
+// ends the run early (signal handlers set it).
+RunReport run_rig(const RunOptions& options, const std::atomic<bool>& stop, std::ostream& out);
+// The same with a config already loaded (and possibly edited: the hidden-effect
+// generator); options.config_path and case_name are then only reported.
+RunReport run_rig(const RigConfig& config, const RunOptions& options, const std::atomic<bool>& stop, std::ostream& out);
+
+}  // namespace rigctl
