@@ -20,14 +20,17 @@
 #include <fcntl.h>
 
 #include "background_process.hpp"
+#include "config_edit.hpp"
 #include "process.hpp"
 #include "read_file.hpp"
 #include "rigctl/sample_t.hpp"
 #include "rigctl/state_t.hpp"
 #include "tools/log2csv.hpp"
+#include "wait_until.hpp"
 
 using rigctl::test::BackgroundProcess;
 using rigctl::test::run_command;
+using rigctl::test::wait_until;
 namespace fs = std::filesystem;
 
 namespace {
@@ -87,9 +90,11 @@ class SafetyRun : public ::testing::Test {
 
   // The shipped config plus an `indicate` detector that trips when the rod
   // passes 30 mm on its ramp (about 2.5 s into the run): an event in the
-  // middle of the run that the logs must keep.
+  // middle of the run that the logs must keep, and the event the tests wait
+  // for. The run is paced at normal priority, so overruns only indicate
+  // (tests/config_edit.hpp).
   std::string marked_config() {
-    std::string text = read_file(kConfig);
+    std::string text = rigctl::test::without_overrun_stop(read_file(kConfig));
     const std::string anchor = "  detectors:                 # checked every tick";
     const auto at = text.find(anchor);
     EXPECT_NE(at, std::string::npos);
@@ -107,6 +112,16 @@ class SafetyRun : public ::testing::Test {
         path("out.txt"));
   }
 
+  // Waits until the run's event log holds the marker's trip: the rod is on
+  // its ramp, past 30 mm, and every state change before it is logged.
+  // Rig time, not wall time: a run the machine slows down gets there later.
+  bool wait_for_marker() const {
+    const auto tripped = [&] {
+      return read_file(path("run.lcm.events")).find("code=limit_tripped channel=x_r") != std::string::npos;
+    };
+    return wait_until(tripped, 60.0);
+  }
+
   fs::path dir_;
 };
 
@@ -114,11 +129,14 @@ class SafetyRun : public ::testing::Test {
 
 TEST_F(SafetyRun, KillNineLosesNoEventAndABoundedStretchOfTelemetry) {
   auto proc = start_run(marked_config());
-  ASSERT_TRUE(proc->wait_for("telemetry:", 20.0)) << proc->output();
-  // Past the marker trip (~2.5 s of rig time) and well into the ramp.
-  std::this_thread::sleep_for(std::chrono::milliseconds(4500));
-  ASSERT_TRUE(proc->wait_for("telemetry:", 0.1));
+  ASSERT_TRUE(proc->wait_for("telemetry:", 60.0)) << proc->output();
+  // Past the marker trip (~2.5 s of rig time), and the log on disk holds
+  // more than a second of it: the kill comes in the middle of a run with
+  // something flushed to lose or keep, however slowly the machine ran it.
+  ASSERT_TRUE(wait_for_marker()) << proc->output();
+  ASSERT_TRUE(wait_until([&] { return read_lcm_log(path("run.lcm")).samples > 400; }, 60.0)) << proc->output();
   const pid_t pid = proc->pid();
+  ASSERT_GT(pid, 0) << "the run ended by itself\n" << proc->output();
   const int64_t kill_utime = wall_utime_now();
   ASSERT_EQ(::kill(pid, SIGKILL), 0);
   proc->wait();
@@ -163,9 +181,11 @@ TEST_F(SafetyRun, KillNineLosesNoEventAndABoundedStretchOfTelemetry) {
 
 TEST_F(SafetyRun, SigtermStopsInTheControlledWayAndClosesTheLogs) {
   auto proc = start_run(marked_config());
-  ASSERT_TRUE(proc->wait_for("telemetry:", 20.0)) << proc->output();
-  // Mid-ramp: the demand moves at 0.02 m/s and must be braked, not cut.
-  std::this_thread::sleep_for(std::chrono::milliseconds(3000));
+  ASSERT_TRUE(proc->wait_for("telemetry:", 60.0)) << proc->output();
+  // Mid-ramp: the demand moves at 0.02 m/s and must be braked, not cut. The
+  // marker trips on the ramp at ~2.5 s of rig time; the ramp runs to ~5 s.
+  ASSERT_TRUE(wait_for_marker()) << proc->output();
+  ASSERT_GT(proc->pid(), 0) << "the run ended by itself\n" << proc->output();
   ASSERT_EQ(::kill(proc->pid(), SIGTERM), 0);
   const int status = proc->wait();
   const std::string output = proc->output();
