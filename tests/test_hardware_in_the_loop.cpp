@@ -99,20 +99,40 @@ class HardwareInTheLoop : public ::testing::Test {
     return std::stoi(m[1].str());
   }
 
+  // Waits until rig-sim's plant, which sits with the valve closed until the
+  // loop starts, has settled (about 0.5 s; 1 s of its clock): the run then
+  // starts from the same state however long a loaded machine takes to
+  // start it.
+  void wait_until_rig_sim_settled() {
+    const std::regex report(R"(rig-sim: t = ([0-9.]+) s, valve)");
+    EXPECT_TRUE(sim_->wait_until(
+        [&](const std::string& out) {
+          for (auto it = std::sregex_iterator(out.begin(), out.end(), report); it != std::sregex_iterator(); ++it) {
+            if (std::stod((*it)[1].str()) >= 1.0) return true;
+          }
+          return false;
+        },
+        60.0))
+        << sim_->output();
+  }
+
   std::unique_ptr<BackgroundProcess> sim_;
   int sims_ = 0;
   fs::path dir_;
 };
 
 // Max and RMS of the difference between a recording (t_a, a) and a
-// reference (t_b, b), compared at the reference's times. The hardware run is
-// timed by the monotonic clock, so ticks skipped after an overrun shift its
-// rows; comparing at equal rig time keeps that from looking like an error.
+// reference (t_b, b), compared at the reference's times from t_from on. The
+// hardware run is timed by the monotonic clock, so ticks skipped after an
+// overrun shift its rows; comparing at equal rig time keeps that from
+// looking like an error.
 std::pair<double, double> difference(const std::vector<double>& t_a, const std::vector<double>& a,
-                                     const std::vector<double>& t_b, const std::vector<double>& b) {
+                                     const std::vector<double>& t_b, const std::vector<double>& b,
+                                     double t_from = 0.0) {
   double max = 0.0, sum = 0.0;
   std::size_t n = 0, j = 0;
   for (std::size_t i = 0; i < t_b.size(); ++i) {
+    if (t_b[i] < t_from) continue;
     while (j + 1 < t_a.size() && t_a[j + 1] < t_b[i]) ++j;
     if (j + 1 >= t_a.size()) break;
     const double w = (t_b[i] - t_a[j]) / (t_a[j + 1] - t_a[j]);
@@ -124,24 +144,49 @@ std::pair<double, double> difference(const std::vector<double>& t_a, const std::
   return {max, std::sqrt(sum / static_cast<double>(std::max<std::size_t>(n, 1)))};
 }
 
+std::vector<double> minus(std::vector<double> a, const std::vector<double>& b) {
+  for (std::size_t i = 0; i < a.size() && i < b.size(); ++i) a[i] -= b[i];
+  return a;
+}
+
+// The end of the profile's ramp (hold_s + ramp_target / ramp_rate): the
+// demand starts where the rod stands (`start: measured`) and from here on is
+// the same whatever that was.
+constexpr double kRampEnd = 1.0 + 0.08 / 0.02;
+
+// rig-sim's plant sits with the valve closed until the loop starts and
+// settles 1.4 mm away from where the in-process plant starts (the test
+// waits for that, so it is the same however late a loaded machine starts
+// the run). Until the ramp's end the two runs' demands differ by that, so
+// the loop is compared by its tracking error x_r - x_ref over the whole run,
+// and the positions from the ramp's end on, through the steps.
+//
+// The wire adds up to a period of delay each way and the DAQ's 16-bit
+// quantisation; the body's stick-slip turns small timing changes into a
+// different stick position, so its bounds are wider. One period of wire
+// delay at the step's peak rod speed (0.19 m/s) is 0.48 mm: the bound for
+// the rms of the rod and wheel. Measured here, both paths, with stress-ng
+// on both cores: tracking rms 0.07-0.09 mm, max 0.5-0.8 mm; x_r and x_w
+// from the ramp's end rms 0.05-0.11 mm, max 0.3-0.9 mm; x_b rms 0.31-0.40
+// mm, max 2.4-2.6 mm.
 void expect_matches_in_process_run(const std::string& hardware_csv, const std::string& reference_csv) {
   const RunFile hw = read_run_file(hardware_csv), ref = read_run_file(reference_csv);
   ASSERT_GT(hw.rows.size(), 8000u);
+  const auto check = [](const std::string& what, std::pair<double, double> d, double max_rms, double max_max) {
+    const auto [max, rms] = d;
+    std::printf("%s: hardware path vs in-process: max %.3f mm, rms %.3f mm\n", what.c_str(), max * 1e3, rms * 1e3);
+    EXPECT_LT(rms, max_rms) << what;
+    EXPECT_LT(max, max_max) << what;
+  };
+  check("x_r - x_ref (whole run)",
+        difference(hw.column("t"), minus(hw.column("x_r"), hw.column("x_ref")), ref.column("t"),
+                   minus(ref.column("x_r"), ref.column("x_ref"))),
+        0.48e-3, 2e-3);
   for (const char* ch : {"x_r", "x_w", "x_b"}) {
-    const auto [max, rms] = difference(hw.column("t"), hw.column(ch), ref.column("t"), ref.column(ch));
-    std::printf("%s: hardware path vs in-process: max %.3f mm, rms %.3f mm\n", ch, max * 1e3, rms * 1e3);
-    // The wire adds up to a period of delay each way and the DAQ's 16-bit
-    // quantisation, and rig-sim's plant ran with the valve closed until the
-    // loop started; the body's stick-slip turns small timing changes into a
-    // different stick position, so its bounds are wider.
     const bool body = std::string(ch) == "x_b";
-    // One period of wire delay at the step's peak rod speed (0.19 m/s) is
-    // 0.48 mm: the bound for x_r and x_w rms. Measured here since the state
-    // machine's arm/start sequence: x_r, x_w rms 0.18-0.33 mm (the CANopen
-    // path, whose two heartbeating processes start less in step), max
-    // 0.6-1.5 mm; x_b rms 0.35-0.5 mm.
-    EXPECT_LT(rms, body ? 1e-3 : 0.48e-3) << ch;
-    EXPECT_LT(max, body ? 4e-3 : 2e-3) << ch;
+    check(std::string(ch) + " (from the ramp's end)",
+          difference(hw.column("t"), hw.column(ch), ref.column("t"), ref.column(ch), kRampEnd),
+          body ? 1e-3 : 0.48e-3, body ? 4e-3 : 2e-3);
   }
 }
 
@@ -150,6 +195,7 @@ void expect_matches_in_process_run(const std::string& hardware_csv, const std::s
 TEST_F(HardwareInTheLoop, StepTestOverModbusTcpMatchesTheInProcessSimulation) {
   const int port = start_rig_sim({});
   ASSERT_GT(port, 0);
+  wait_until_rig_sim_settled();
   const auto run = run_command(kRigctl + " run " + write_config("modbus", port) + " --log " + path("hw.lcm") +
                                " --csv " + path("hw.csv"));
   ASSERT_EQ(run.exit_code, 0) << run.output << sim_->output();
@@ -166,6 +212,7 @@ TEST_F(HardwareInTheLoop, StepTestWithTheCanopenValveMatchesTheInProcessSimulati
   const int port = start_rig_sim({"--can-socket", path("valve.sock")});
   ASSERT_GT(port, 0);
   ASSERT_TRUE(sim_->wait_for("canopen valve on", 60.0)) << sim_->output();
+  wait_until_rig_sim_settled();
   const auto run = run_command(kRigctl + " run " + write_config("modbus_canopen", port) + " --log " + path("hw.lcm") +
                                " --csv " + path("hw.csv"));
   ASSERT_EQ(run.exit_code, 0) << run.output << sim_->output();
