@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <functional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -41,24 +42,34 @@ class BackgroundProcess {
   // test's own signals (kill -9, SIGTERM).
   pid_t pid() const { return pid_; }
 
-  // Waits until the output contains `text`; false after the timeout or when
-  // the process ended first.
-  bool wait_for(const std::string& text, double timeout_s) {
+  // Waits until `done(output)` holds; false after the timeout or when the
+  // process ended first. The timeout is a deadline for a hung process, so
+  // callers give generous ones: it costs time only when the test fails.
+  bool wait_until(const std::function<bool(const std::string&)>& done, double timeout_s) {
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
     while (std::chrono::steady_clock::now() < deadline) {
-      if (output().find(text) != std::string::npos) return true;
-      if (exited()) return output().find(text) != std::string::npos;
+      if (done(output())) return true;
+      if (exited()) return done(output());
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
-    return false;
+    return done(output());
   }
 
-  // SIGINT, then wait (SIGKILL after 10 s). Returns the exit status, -1 if killed.
+  // Waits until the output contains `text` (as wait_until).
+  bool wait_for(const std::string& text, double timeout_s) {
+    return wait_until([&](const std::string& out) { return out.find(text) != std::string::npos; }, timeout_s);
+  }
+
+  // SIGINT, then wait (SIGKILL after 30 s: a loaded machine may take seconds
+  // to let a process close its logs). Returns the exit status, -1 if killed.
   int stop() {
     if (pid_ <= 0) return status_;
     if (!exited()) {
       kill(pid_, SIGINT);
-      for (int i = 0; i < 1000 && !exited(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+      while (!exited() && std::chrono::steady_clock::now() < deadline) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      }
       if (!exited()) {
         kill(pid_, SIGKILL);
         int st = 0;

@@ -140,7 +140,25 @@ TEST_F(CliTest, SigintStopsThePacedRunCleanlyAndKeepsTheLog) {
           static_cast<char*>(nullptr));
     _exit(127);
   }
-  std::this_thread::sleep_for(std::chrono::milliseconds(800));
+  // SIGINT once the loop runs: its console status (once a second) shows rig
+  // time past 0.5 s. Waited for, not slept for: a loaded machine may take
+  // seconds to start the program, and a SIGINT before its handler is set
+  // would kill it.
+  const std::regex status_line(R"(\bt +([0-9.]+)/30\.0 s)");
+  bool running = false;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (!running && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    const std::string out = read_file(out_path);
+    for (auto it = std::sregex_iterator(out.begin(), out.end(), status_line); it != std::sregex_iterator(); ++it) {
+      running = running || std::stod((*it)[1].str()) >= 0.5;
+    }
+  }
+  if (!running) {
+    kill(pid, SIGKILL);
+    waitpid(pid, nullptr, 0);
+  }
+  ASSERT_TRUE(running) << read_file(out_path);
   ASSERT_EQ(kill(pid, SIGINT), 0);
   int status = 0;
   ASSERT_EQ(waitpid(pid, &status, 0), pid);

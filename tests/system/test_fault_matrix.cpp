@@ -7,10 +7,11 @@
 //  * the valve at its safe command (0) within a stated number of periods,
 //  * the event in the event log with its reason naming the channel,
 //  * no gap in the telemetry ticks before the fault.
-// In-process faults (the simulated driver) run --fast; the wire's faults run
-// paced against `rigctl rig-sim` as tests/system/test_hardware_in_the_loop.cpp does,
-// and their time to a safe valve is measured on the far side (rig-sim prints
-// where the final stretch of null valve commands began).
+// In-process faults (the simulated driver) run --fast: rig time is ticks,
+// whatever the machine does. The wire's faults run paced against `rigctl
+// rig-sim` as tests/system/test_hardware_in_the_loop.cpp does, and their time to a
+// safe valve is measured on the far side, on rig-sim's simulated clock (it
+// prints where the final stretch of null valve commands began).
 // Each test prints a MATRIX line with what it measured.
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
@@ -28,6 +29,7 @@
 #include "read_file.hpp"
 #include "rigctl/driver_status_t.hpp"
 #include "rigctl/sample_t.hpp"
+#include "wire_config.hpp"
 
 using rigctl::test::BackgroundProcess;
 using rigctl::test::run_command;
@@ -273,44 +275,45 @@ TEST_F(FaultMatrix, BurstPipeOnTheCapSideIsInterlocked) {
 
 // ---------------------------------------------------------------------------
 // On the wire: rig-sim's faults through the Modbus DAQ and CANopen valve
-// drivers, paced. The test config allows this shared VM's stalls as
-// tests/system/test_hardware_in_the_loop.cpp does: 10 ms replies, 100 ms (40
-// periods) of sample age.
+// drivers, paced, with the test config of tests/support/wire_config.hpp: start-up
+// times in seconds (a loaded machine only starts the run later), and 10 ms
+// replies and 100 ms (40 periods) of sample age while running.
+//
+// Why the period bounds below hold on a loaded machine: from the fault to
+// the null valve everything runs in SCHED_FIFO threads (rig-sim's plant and
+// valve node, the loop, the drivers' I/O threads), which a CPU hog at
+// normal priority cannot delay, and the time is read on rig-sim's clock.
+// Where SCHED_FIFO is refused (no CAP_SYS_NICE) that no longer holds: the
+// test then checks everything but the bounds and says so by skipping.
 
 namespace {
 
-constexpr double kMaxAge = 0.1;
-
 class WireFaultMatrix : public FaultMatrix {
  protected:
-  std::string write_config(const std::string& driver, int port) {
-    std::string text = read_file(kConfig);
-    text = std::regex_replace(text, std::regex("\ndriver: sim"), "\ndriver: " + driver);
-    text = std::regex_replace(text, std::regex("port: 1502"), "port: " + std::to_string(port));
-    text = std::regex_replace(text, std::regex("response_timeout_s: 0.002"), "response_timeout_s: 0.01");
-    text = std::regex_replace(text, std::regex("max_sample_age_s: 0.0125"), "max_sample_age_s: " + std::to_string(kMaxAge));
-    text = std::regex_replace(text, std::regex("actual_max_age_s: 0.0125"), "actual_max_age_s: " + std::to_string(kMaxAge));
-    text = std::regex_replace(text, std::regex("socket_path: /run/rigctl/valve.sock"), "socket_path: " + path("valve.sock"));
+  std::string write_config(const std::string& driver, int port, double heartbeat_timeout_s) {
     const std::string file = path(driver + ".yaml");
-    std::ofstream(file) << text;
+    std::ofstream(file) << rigctl::test::wire_config(driver, port, path("valve.sock"), heartbeat_timeout_s);
     return file;
   }
 
   // rig-sim with the fault, then `rigctl run` against it; checks the matrix's
-  // points and prints the MATRIX line.
-  void run_on_wire(const std::string& driver, const std::string& fault, int max_detect_periods, int max_safe_periods) {
-    std::vector<std::string> argv{kRigctl, "rig-sim", write_config("sim", 1502), "--modbus", "127.0.0.1:0", "--fault", fault};
+  // points and prints the MATRIX line. heartbeat_timeout_s: the valve's, in
+  // the run's config.
+  void run_on_wire(const std::string& driver, const std::string& fault, int max_detect_periods, int max_safe_periods,
+                   double heartbeat_timeout_s = rigctl::test::kWireMaxAge) {
+    std::vector<std::string> argv{kRigctl, "rig-sim", write_config("sim", 1502, heartbeat_timeout_s),
+                                  "--modbus", "127.0.0.1:0", "--fault", fault};
     if (driver == "modbus_canopen") argv.insert(argv.end(), {"--can-socket", path("valve.sock")});
     BackgroundProcess sim(argv, path("rig-sim.out"));
-    ASSERT_TRUE(sim.wait_for("modbus listening on", 10.0)) << sim.output();
+    ASSERT_TRUE(sim.wait_for("modbus listening on", 60.0)) << sim.output();
     if (driver == "modbus_canopen") {
-      ASSERT_TRUE(sim.wait_for("canopen valve on", 5.0)) << sim.output();
+      ASSERT_TRUE(sim.wait_for("canopen valve on", 60.0)) << sim.output();
     }
     std::smatch m;
     const std::string started = sim.output();
     ASSERT_TRUE(std::regex_search(started, m, std::regex(R"(modbus listening on 127\.0\.0\.1:(\d+))"))) << started;
     const std::string log = path("f.lcm");
-    const auto run = run_command(kRigctl + " run " + write_config(driver, std::stoi(m[1].str())) +
+    const auto run = run_command(kRigctl + " run " + write_config(driver, std::stoi(m[1].str()), heartbeat_timeout_s) +
                                  " --duration 10 --log " + log);
     EXPECT_EQ(run.exit_code, 3) << fault << ":\n" << run.output << sim.output();
     sim.stop();  // prints where the final stretch of null valve commands began
@@ -325,7 +328,6 @@ class WireFaultMatrix : public FaultMatrix {
     // Not before the fault: the loop drove the valve until then.
     EXPECT_GE(t_null, t_fault) << out;
     const long safe = std::lround((t_null - t_fault) / kPeriod);
-    EXPECT_LE(safe, max_safe_periods) << fault << "\n" << out;
 
     // The event log: an input invalid (or the read failing) with its reason
     // naming the channel, and the rig faulted on that tick.
@@ -368,17 +370,27 @@ class WireFaultMatrix : public FaultMatrix {
       detect = std::lround((trip->t - contents.times[first_stale]) / kPeriod);
       EXPECT_GE(detect, 0);
     }
-    EXPECT_LE(detect, max_detect_periods) << fault;
     std::printf("MATRIX %s (%s): %s \"%s\" after %s%ld periods (%.1f ms), valve null at the rig after %ld periods (%.1f ms)\n",
                 fault.c_str(), driver.c_str(), trip->code.c_str(), trip->message.c_str(),
                 driver == "modbus" ? "" : "<= ", detect, detect * kPeriod * 1e3, safe, safe * kPeriod * 1e3);
+
+    // The bounds, where the chain from fault to null ran at SCHED_FIFO.
+    for (const std::string& side : {run.output, out}) {
+      if (std::regex_search(side, std::regex("SCHED_FIFO priority [0-9]+ refused"))) {
+        GTEST_SKIP() << "SCHED_FIFO refused, so a loaded machine can delay the fault's handling: "
+                        "everything but the period bounds was checked\n" << side;
+      }
+    }
+    EXPECT_LE(detect, max_detect_periods) << fault;
+    EXPECT_LE(safe, max_safe_periods) << fault << "\n" << out;
   }
 };
 
 }  // namespace
 
 // Bounds: the detection time the driver's configuration sets (sample age,
-// heartbeat timeout) plus 24 periods (60 ms) of scheduling on this VM.
+// heartbeat timeout) plus 24 periods (60 ms) for this VM's stalls of the
+// SCHED_FIFO threads (see above).
 TEST_F(WireFaultMatrix, DaqTimeoutIsStaleDataAndNullsTheValve) {
   run_on_wire("modbus", "silence@3", 40 + 8, 40 + 24);
 }
@@ -388,7 +400,8 @@ TEST_F(WireFaultMatrix, DaqDisconnectIsStaleDataAndNullsTheValve) {
 }
 
 TEST_F(WireFaultMatrix, CanHeartbeatLossNullsTheValve) {
-  run_on_wire("modbus_canopen", "heartbeat@3:2", 20 + 24, 20 + 24);
+  // The shipped heartbeat timeout, 50 ms (20 periods): what is measured here.
+  run_on_wire("modbus_canopen", "heartbeat@3:2", 20 + 24, 20 + 24, 0.05);
 }
 
 TEST_F(WireFaultMatrix, EmcyNullsTheValve) {

@@ -529,7 +529,7 @@ class OperatorCommandsUdpm : public ::testing::Test {
   test::TestNetns ns_{"opcmd"};
 };
 
-// Pops whatever the receiver queued within `timeout`.
+// Pops what the receiver queued, until `want` commands or `timeout`.
 std::vector<OperatorCommand> drain(CommandReceiver& rx, std::size_t want, std::chrono::milliseconds timeout) {
   std::vector<OperatorCommand> out;
   const auto deadline = std::chrono::steady_clock::now() + timeout;
@@ -561,37 +561,44 @@ TEST_F(OperatorCommandsUdpm, RigctlCmdReachesTheReceiverAndTheAckComesBack) {
     opt.channel = "RIGCTL_OPERATOR";
     opt.key_path = key;
     opt.policy = policy();
+    // A command is stamped before a loaded machine gets it to the receiver:
+    // 30 s, not 2 s, of age allowed here (the window is tested above).
+    opt.policy.max_age_us = 30'000'000;
     opt.queue_capacity = 2;
     CommandReceiver rx(opt);
     rx.start();
 
-    // 1. A valid command: accepted, queued, acknowledged.
-    auto r = rigctl_cmd("arm" + common + " --wait-ack 5");
+    // 1. A valid command: accepted, queued, acknowledged. `rigctl cmd`
+    //    returns at the ack: its wait is a deadline for a receiver that
+    //    never answers.
+    auto r = rigctl_cmd("arm" + common + " --wait-ack 30");
     EXPECT_EQ(r.exit_code, kCmdAccepted) << r.output;
     EXPECT_NE(r.output.find("accepted by the rig"), std::string::npos) << r.output;
-    auto got = drain(rx, 1, std::chrono::seconds(2));
+    auto got = drain(rx, 1, std::chrono::seconds(30));
     ASSERT_EQ(got.size(), 1u);
     EXPECT_EQ(got[0].kind, OperatorCommandKind::kArm);
     const uint64_t first_sequence = got[0].sequence;
 
     // 2. A setpoint within the limits; the sequence went up between invocations.
-    r = rigctl_cmd("setpoint 0.02" + common + " --wait-ack 5");
+    r = rigctl_cmd("setpoint 0.02" + common + " --wait-ack 30");
     EXPECT_EQ(r.exit_code, kCmdAccepted) << r.output;
-    got = drain(rx, 1, std::chrono::seconds(2));
+    got = drain(rx, 1, std::chrono::seconds(30));
     ASSERT_EQ(got.size(), 1u);
     EXPECT_EQ(got[0].kind, OperatorCommandKind::kSetpoint);
     EXPECT_EQ(got[0].value, 0.02);
     EXPECT_GT(got[0].sequence, first_sequence);
 
     // 3. Out of limits: the rig says so, and the exit code says rejected.
-    r = rigctl_cmd("setpoint 0.2" + common + " --wait-ack 5");
+    r = rigctl_cmd("setpoint 0.2" + common + " --wait-ack 30");
     EXPECT_EQ(r.exit_code, kCmdRejected) << r.output;
     EXPECT_NE(r.output.find("rejected by the rig: out_of_limits"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("0.2 m outside [-0.05, 0.05] m"), std::string::npos) << r.output;
 
     // 4. The wrong key: counted as bad_tag; the rig's reply does not verify
     //    with the sender's key, so the sender reports no acknowledgement.
-    r = rigctl_cmd("start --key " + wrong_key + " --sender op2 --state-file " + (dir.path() / "op2.seq").string() + " --wait-ack 1");
+    //    It waits its whole --wait-ack for one that verifies: 5 s, for the
+    //    reply that does not to arrive within it on a loaded machine.
+    r = rigctl_cmd("start --key " + wrong_key + " --sender op2 --state-file " + (dir.path() / "op2.seq").string() + " --wait-ack 5");
     EXPECT_EQ(r.exit_code, kCmdNoAck) << r.output;
     EXPECT_NE(r.output.find("different key"), std::string::npos) << r.output;
 
@@ -607,7 +614,7 @@ TEST_F(OperatorCommandsUdpm, RigctlCmdReachesTheReceiverAndTheAckComesBack) {
       const auto b = signed_bytes(command(s == 3 ? "stop" : "resume", s, 0.0, now, "raw"), k);
       bus.publish("RIGCTL_OPERATOR", b.data(), static_cast<unsigned int>(b.size()));
     }
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(3);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
     while (acks.acks.size() < 4 && std::chrono::steady_clock::now() < deadline) bus.handleTimeout(50);
     ASSERT_EQ(acks.acks.size(), 4u);
     EXPECT_TRUE(acks.acks[0].accepted);
@@ -616,6 +623,7 @@ TEST_F(OperatorCommandsUdpm, RigctlCmdReachesTheReceiverAndTheAckComesBack) {
     EXPECT_TRUE(acks.acks[2].accepted);
     EXPECT_EQ(acks.acks[3].reason, "queue_full");
     for (const auto& a : acks.acks) EXPECT_TRUE(tag_valid(a, k)) << "ack for sequence " << a.sequence;
+    // The four acks say the receiver has handled all four: what it queued is final.
     got = drain(rx, 3, std::chrono::milliseconds(500));
     ASSERT_EQ(got.size(), 2u);
     EXPECT_EQ(got[0].kind, OperatorCommandKind::kHold);

@@ -20,14 +20,17 @@
 #include <fcntl.h>
 
 #include "background_process.hpp"
+#include "config_edit.hpp"
 #include "process.hpp"
 #include "read_file.hpp"
 #include "rigctl/sample_t.hpp"
 #include "rigctl/state_t.hpp"
 #include "tools/runfile/log2csv.hpp"
+#include "wait_until.hpp"
 
 using rigctl::test::BackgroundProcess;
 using rigctl::test::run_command;
+using rigctl::test::wait_until;
 namespace fs = std::filesystem;
 
 namespace {
@@ -87,9 +90,11 @@ class SafetyRun : public ::testing::Test {
 
   // The shipped config plus an `indicate` detector that trips when the rod
   // passes 30 mm on its ramp (about 2.5 s into the run): an event in the
-  // middle of the run that the logs must keep.
+  // middle of the run that the logs must keep, and the event the tests wait
+  // for. The run is paced at normal priority, so overruns only indicate
+  // (tests/support/config_edit.hpp).
   std::string marked_config() {
-    std::string text = read_file(kConfig);
+    std::string text = rigctl::test::without_overrun_stop(read_file(kConfig));
     const std::string anchor = "  detectors:                 # checked every tick";
     const auto at = text.find(anchor);
     EXPECT_NE(at, std::string::npos);
@@ -107,6 +112,16 @@ class SafetyRun : public ::testing::Test {
         path("out.txt"));
   }
 
+  // Waits until the run's event log holds the marker's trip: the rod is on
+  // its ramp, past 30 mm, and every state change before it is logged.
+  // Rig time, not wall time: a run the machine slows down gets there later.
+  bool wait_for_marker() const {
+    const auto tripped = [&] {
+      return read_file(path("run.lcm.events")).find("code=limit_tripped channel=x_r") != std::string::npos;
+    };
+    return wait_until(tripped, 60.0);
+  }
+
   fs::path dir_;
 };
 
@@ -114,11 +129,14 @@ class SafetyRun : public ::testing::Test {
 
 TEST_F(SafetyRun, KillNineLosesNoEventAndABoundedStretchOfTelemetry) {
   auto proc = start_run(marked_config());
-  ASSERT_TRUE(proc->wait_for("telemetry:", 20.0)) << proc->output();
-  // Past the marker trip (~2.5 s of rig time) and well into the ramp.
-  std::this_thread::sleep_for(std::chrono::milliseconds(4500));
-  ASSERT_TRUE(proc->wait_for("telemetry:", 0.1));
+  ASSERT_TRUE(proc->wait_for("telemetry:", 60.0)) << proc->output();
+  // Past the marker trip (~2.5 s of rig time), and the log on disk holds
+  // more than a second of it: the kill comes in the middle of a run with
+  // something flushed to lose or keep, however slowly the machine ran it.
+  ASSERT_TRUE(wait_for_marker()) << proc->output();
+  ASSERT_TRUE(wait_until([&] { return read_lcm_log(path("run.lcm")).samples > 400; }, 60.0)) << proc->output();
   const pid_t pid = proc->pid();
+  ASSERT_GT(pid, 0) << "the run ended by itself\n" << proc->output();
   const int64_t kill_utime = wall_utime_now();
   ASSERT_EQ(::kill(pid, SIGKILL), 0);
   proc->wait();
@@ -147,14 +165,15 @@ TEST_F(SafetyRun, KillNineLosesNoEventAndABoundedStretchOfTelemetry) {
     EXPECT_TRUE(found) << "LCM log event " << s.event << " at tick " << s.tick << " missing from the event log";
   }
   // The telemetry lost: from the last logged sample to the kill. The
-  // publisher flushes the log every second (rt/comms/telemetry_publisher.cpp), so
+  // publisher flushes the log every 250 ms (rt/comms/telemetry_publisher.cpp), so
   // the gap is that plus the queue's drain lag; measured values are in
-  // SAFETY.md. The bound here is twice the documented one, not a timing test.
+  // SAFETY.md. The bound here is eight flush intervals, room for a loaded
+  // machine: not a timing test, a check that the log is flushed at all.
   const double gap_s = static_cast<double>(kill_utime - log.last_sample_utime) * 1e-6;
   RecordProperty("telemetry_gap_ms", static_cast<int>(gap_s * 1000.0));
   std::printf("kill -9 at rig time ~%.3f s: last logged sample t = %.3f s, telemetry gap %.0f ms\n",
               log.last_sample_t + gap_s, log.last_sample_t, gap_s * 1000.0);
-  EXPECT_LT(gap_s, 2.0) << "documented bound: 1 s flush interval";
+  EXPECT_LT(gap_s, 2.0) << "the log is flushed every 250 ms";
   EXPECT_GT(gap_s, 0.0);
   // And it still converts.
   const auto csv = rigctl::log_to_csv(path("run.lcm"), path("run.csv"));
@@ -163,9 +182,11 @@ TEST_F(SafetyRun, KillNineLosesNoEventAndABoundedStretchOfTelemetry) {
 
 TEST_F(SafetyRun, SigtermStopsInTheControlledWayAndClosesTheLogs) {
   auto proc = start_run(marked_config());
-  ASSERT_TRUE(proc->wait_for("telemetry:", 20.0)) << proc->output();
-  // Mid-ramp: the demand moves at 0.02 m/s and must be braked, not cut.
-  std::this_thread::sleep_for(std::chrono::milliseconds(3000));
+  ASSERT_TRUE(proc->wait_for("telemetry:", 60.0)) << proc->output();
+  // Mid-ramp: the demand moves at 0.02 m/s and must be braked, not cut. The
+  // marker trips on the ramp at ~2.5 s of rig time; the ramp runs to ~5 s.
+  ASSERT_TRUE(wait_for_marker()) << proc->output();
+  ASSERT_GT(proc->pid(), 0) << "the run ended by itself\n" << proc->output();
   ASSERT_EQ(::kill(proc->pid(), SIGTERM), 0);
   const int status = proc->wait();
   const std::string output = proc->output();

@@ -1,9 +1,12 @@
 // The Modbus DAQ client (ModbusDaq) against the simulated module
 // (SimModbusDaq), both real libmodbus over TCP on 127.0.0.1 (a free port),
-// and the `modbus:` config reader. No test asserts on this machine's timing
-// beyond generous bounds: conditions are polled with deadlines.
+// and the `modbus:` config reader. No test asserts on this machine's timing:
+// conditions are polled with deadlines, the times in the test configs are
+// sized for a loaded machine, and "never blocks" is counted in context
+// switches, not in microseconds.
 #include <gtest/gtest.h>
 #include <netinet/in.h>
+#include <sys/resource.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -25,8 +28,10 @@
 #include "drivers/modbus/modbus_link.hpp"
 #include "drivers/sim/sim_modbus_daq.hpp"
 #include "rt/histogram.hpp"
+#include "wait_until.hpp"
 
 using namespace rigctl;
+using rigctl::test::wait_until;
 
 // Counts this thread's heap allocations, to show the loop-side calls make none
 // (the I/O and server threads allocate freely and are not counted).
@@ -47,16 +52,6 @@ thread_local long t_allocations = 0;
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-// Polls cond every millisecond until it holds or timeout_s passes.
-bool wait_until(const std::function<bool()>& cond, double timeout_s = 10.0) {
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-  while (std::chrono::steady_clock::now() < deadline) {
-    if (cond()) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  }
-  return cond();
-}
 
 ModbusChannel channel(const std::string& name, int unit, RegisterType type, int address, DataFormat format,
                       WordOrder order, Calibration cal, double safe = 0.0) {
@@ -83,8 +78,12 @@ ModbusDaqConfig rig_config() {
   c.connection.transport = ModbusTransport::kTcp;
   c.connection.host = "127.0.0.1";
   c.connection.port = 0;
-  c.connection.response_timeout_s = 0.02;  // tight for a LAN, loose enough for a loaded 2-core VM
-  c.connection.reconnect_interval_s = 0.05;
+  // Generous for a LAN: a server or client thread that a loaded 2-core
+  // machine leaves waiting must not look like a timeout, nor a silent link
+  // (no answer for a reconnect interval) like a dead one. The fault tests
+  // make their timeouts happen (a silent server, late replies).
+  c.connection.response_timeout_s = 0.2;
+  c.connection.reconnect_interval_s = 1.0;
   c.poll_period_s = 0.0025;
   c.max_sample_age_s = 0.25;  // generous: "fresh" must not flicker under load
   c.max_gap = 4;
@@ -241,10 +240,13 @@ TEST_F(ModbusDaqTest, OutputsWrittenByTheClientArriveDecodedOnTheServer) {
     sim_->outputs(out);
     return std::abs(out[0] - 0.25) < 3.1e-5;
   }));
+  // Nothing else writes after stop(); waited for, as the server applies the
+  // write on its own thread.
   daq_->stop();
-  sim_->outputs(out);
-  EXPECT_EQ(out[0], 0.0);
-  EXPECT_NEAR(out[1], 2.0e5, 1.0);
+  EXPECT_TRUE(wait_until([&] {
+    sim_->outputs(out);
+    return out[0] == 0.0 && std::abs(out[1] - 2.0e5) < 1.0;
+  })) << out[0] << " " << out[1];
 }
 
 TEST_F(ModbusDaqTest, LoopSideReadNeverBlocksWhileTheIoThreadWaitsForATimeout) {
@@ -258,21 +260,32 @@ TEST_F(ModbusDaqTest, LoopSideReadNeverBlocksWhileTheIoThreadWaitsForATimeout) {
   const int64_t timeouts_before = daq_->counters().timeouts;
   DurationHistogram calls(100, 100000);  // 0.1 us bins up to 10 ms
   Sample s;
+  // A call that waited for the I/O thread (a lock it holds through its
+  // 300 ms request) would sleep: a voluntary context switch of this thread.
+  // Counted, not timed: a loaded machine preempts calls (involuntary
+  // switches, any length), but cannot make one sleep.
+  const auto voluntary_switches = [] {
+    rusage u{};
+    getrusage(RUSAGE_THREAD, &u);
+    return u.ru_nvcsw;
+  };
+  const long switches_before = voluntary_switches();
   const int64_t end = ModbusDaq::now_ns() + 1'500'000'000;  // spans a whole timeout + drain of 600 ms
   while (ModbusDaq::now_ns() < end) {
     const int64_t t0 = ModbusDaq::now_ns();
     daq_->read_inputs(s, 0, t0);
     calls.record(ModbusDaq::now_ns() - t0);
   }
+  const long switches = voluntary_switches() - switches_before;
   const auto summary = calls.summary();
   std::cout << "read_inputs during a timeout: " << summary.count << " calls, p50 " << summary.p50_ns << " ns, p99 "
-            << summary.p99_ns << " ns, max " << summary.max_ns << " ns\n";
+            << summary.p99_ns << " ns, max " << summary.max_ns << " ns, " << switches << " voluntary context switches\n";
   // The I/O thread really was stuck in timeouts meanwhile.
   EXPECT_GT(daq_->counters().timeouts, timeouts_before);
-  // A call that waited for the I/O thread would take up to 300 ms. Generous
-  // bounds: this VM may preempt any single call for milliseconds.
+  EXPECT_EQ(switches, 0) << "a loop-side read slept, waiting for something";
+  // A waiting call would take up to 300 ms; preemption on a loaded machine
+  // delays a few calls of the hundreds of thousands, not the 99th percentile.
   EXPECT_LT(summary.p99_ns, 500'000);
-  EXPECT_LT(summary.max_ns, 100'000'000);
 }
 
 TEST_F(ModbusDaqTest, LoopSideCallsDoNotAllocate) {
@@ -298,29 +311,30 @@ TEST_F(ModbusDaqTest, SilentServerMakesInputsStaleAndIsCountedAndLogged) {
   const double max_age = sim_->client_config().max_sample_age_s;
 
   sim_->set_silent(true);
-  const auto t0 = std::chrono::steady_clock::now();
   ASSERT_TRUE(wait_until([&] { return all_stale(); }));
-  const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  // Stale once older than max_sample_age (plus a timeout and a few cycles);
-  // the upper bound is generous for a loaded machine.
-  EXPECT_LT(took, max_age + 2.0);
-  // The last values are still there, flagged.
+  // Stale as soon as older than max_sample_age: read_inputs judges the age
+  // at the time it is given, so when that is is the caller's (no wall-clock
+  // bound here). The last values are still there, flagged, and their age
+  // is past the limit.
   Sample s = read();
   EXPECT_NEAR(s.value[0], kValuesA[0], kTolerance[0]);
   EXPECT_GT(daq_->read_inputs(s, 0, ModbusDaq::now_ns()), static_cast<int64_t>(max_age * 1e9));
 
+  // The I/O thread's side: each request waits out its 200 ms timeout, so
+  // the read's timeout may be logged after the inputs went stale; waited for.
+  const std::string timeout_event =
+      "modbus " + sim_->endpoint() + ": timeout (no reply within 200 ms) reading input registers 0-11 of unit 1";
+  EXPECT_TRUE(wait_until([&] {
+    const std::string log = events();
+    return log.find(timeout_event) != std::string::npos && log.find("samples with stale inputs") != std::string::npos;
+  })) << events();
   const auto c = daq_->counters();
   EXPECT_GT(c.timeouts, 0);
   EXPECT_GT(c.stale_samples, 0);
-  const std::string log = events();
-  EXPECT_NE(log.find("modbus " + sim_->endpoint() + ": timeout (no reply within 20 ms) reading input registers 0-11 of unit 1"),
-            std::string::npos)
-      << log;
-  EXPECT_NE(log.find("samples with stale inputs"), std::string::npos) << log;
 
   sim_->set_silent(false);
   ASSERT_TRUE(wait_until([&] { return all_fresh(); }));
-  EXPECT_NE(events().find("works again"), std::string::npos) << events();
+  EXPECT_TRUE(wait_until([&] { return events().find("works again") != std::string::npos; })) << events();
 }
 
 TEST_F(ModbusDaqTest, LateRepliesTimeOutAndDoNotPoisonLaterRequests) {
@@ -328,7 +342,7 @@ TEST_F(ModbusDaqTest, LateRepliesTimeOutAndDoNotPoisonLaterRequests) {
   c.connection.reconnect_interval_s = 60.0;  // keep this connection: a new one would hide a backlog
   start_client(c);
   ASSERT_TRUE(wait_until([&] { return shows(kValuesA); }));
-  sim_->set_reply_delay(0.06);  // three response timeouts
+  sim_->set_reply_delay(0.6);  // three response timeouts
   ASSERT_TRUE(wait_until([&] { return all_stale(); }));
   EXPECT_GT(daq_->counters().timeouts, 0);
   // Replies now arrive long after their request; once on time again, the
@@ -346,23 +360,26 @@ TEST_F(ModbusDaqTest, OneLateReplyDoesNotLeaveTheConnectionOneReplyBehind) {
   auto c = sim_->client_config();
   c.connection.reconnect_interval_s = 60.0;  // a reconnect would hide the desynchronisation
   start_client(c);
-  // Every reply takes 2 ms (well inside the 20 ms timeout), like a busy
+  // Every reply takes 2 ms (well inside the 200 ms timeout), like a busy
   // module's: a reply then always arrives after the client has handled a
   // mismatch, which is when a plain flush cannot catch it.
   sim_->set_reply_delay(0.002);
   ASSERT_TRUE(wait_until([&] { return shows(kValuesA); }));
   for (int episode = 0; episode < 3; ++episode) {
     const int64_t timeouts = daq_->counters().timeouts;
-    sim_->set_reply_delay(0.03);  // 1.5 response timeouts, for the request being served now
+    sim_->set_reply_delay(0.3);  // 1.5 response timeouts, for the request being served now
     ASSERT_TRUE(wait_until([&] { return daq_->counters().timeouts > timeouts; }));
     sim_->set_reply_delay(0.002);
     const double* values = episode % 2 == 0 ? kValuesB.data() : kValuesA.data();
     sim_->set_inputs(values, kValuesA.size());
-    ASSERT_TRUE(wait_until([&] { return shows(episode % 2 == 0 ? kValuesB : kValuesA); }, 5.0))
+    ASSERT_TRUE(wait_until([&] { return shows(episode % 2 == 0 ? kValuesB : kValuesA); }))
         << "episode " << episode << ": " << daq_->counters().protocol_errors << " bad replies\n" << events();
-    // And it stays in step: no further bad replies.
+    // And it stays in step: no further bad replies over the next 100 reads
+    // (counted, not slept for: a slow machine just takes longer to do them).
     const int64_t bad = daq_->counters().protocol_errors;
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    const int64_t reads = daq_->counters().reads;
+    ASSERT_TRUE(wait_until([&] { return daq_->counters().reads >= reads + 100; }))
+        << "episode " << episode << ": " << daq_->counters().protocol_errors - bad << " more bad replies";
     EXPECT_EQ(daq_->counters().protocol_errors, bad) << "episode " << episode;
   }
   EXPECT_EQ(daq_->counters().connection_losses, 0);
@@ -494,7 +511,7 @@ TEST(ModbusDaqStart, AgainstAClosedPortThrowsNamingHostAndPort) {
   c.connection.port = ntohs(addr.sin_port);
   ModbusDaq daq(c);
   try {
-    daq.start(0.5);
+    daq.start(2.0);  // the I/O thread's first attempt fails at once; a loaded machine may start it late
     FAIL() << "start() succeeded against a closed port";
   } catch (const std::runtime_error& e) {
     const std::string what = e.what();

@@ -20,19 +20,12 @@
 #include "drivers/modbus/modbus_daq.hpp"
 #include "drivers/modbus/modbus_link.hpp"
 #include "drivers/sim/sim_modbus_daq.hpp"
+#include "wait_until.hpp"
 
 using namespace rigctl;
+using rigctl::test::wait_until;
 
 namespace {
-
-bool wait_until(const std::function<bool()>& cond, double timeout_s = 10.0) {
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-  while (std::chrono::steady_clock::now() < deadline) {
-    if (cond()) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(2));
-  }
-  return cond();
-}
 
 std::string find_in_path(const std::string& program) {
   const char* path = getenv("PATH");
@@ -112,7 +105,10 @@ ModbusDaqConfig rtu_config(const std::string& device) {
   c.connection.parity = 'E';
   c.connection.data_bits = 8;
   c.connection.stop_bits = 1;
-  c.connection.response_timeout_s = 0.05;  // a pty has no baud rate; this is for a loaded machine
+  // A pty has no baud rate: the timeout is for a loaded machine, where the
+  // slave's thread or socat may wait for a CPU (a reply missed by a timeout
+  // is only retried, but a silent slave is the one test of a timeout here).
+  c.connection.response_timeout_s = 0.2;
   c.connection.reconnect_interval_s = 0.1;
   c.poll_period_s = 0.005;
   c.max_sample_age_s = 0.5;

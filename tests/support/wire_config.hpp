@@ -1,0 +1,50 @@
+// The shipped quarter-car config for the end-to-end tests on the wire:
+// `rigctl run` with a hardware driver against `rigctl rig-sim` on 127.0.0.1
+// and a seqpacket socket in the test's own folder (test_hardware_in_the_loop,
+// test_fault_matrix).
+//
+// Its times are for a loaded 2-core test machine, in two kinds:
+//  * Start-up runs at normal priority (process start, the DAQ's first
+//    sample, the valve's SDO configuration, our heartbeat until the valve
+//    driver's I/O thread takes over): seconds, so a process that is
+//    descheduled or starts from a cold cache only starts later. With the
+//    shipped 0.1 s SDO timeout a run failed here with "no answer within
+//    sdo_timeout_s = 0.1 s".
+//  * Running, the fault-to-safe chain is SCHED_FIFO threads on both sides
+//    (rig-sim's plant and valve, the loop, the drivers' I/O): a CPU hog at
+//    normal priority cannot delay it, the stalls of a shared VM can, by tens
+//    of milliseconds. Allowed for: 10 ms replies, 100 ms (40 periods) of
+//    sample age and of the valve's heartbeat. The fault bounds are stated in
+//    these terms.
+#pragma once
+
+#include <string>
+
+#include "config_edit.hpp"
+
+namespace rigctl::test {
+
+constexpr double kWireMaxAge = 0.1;  // [s] sample age and (unless a test is about it) heartbeat timeout
+
+// driver: modbus, modbus_canopen, or sim for rig-sim's own copy. port: the
+// DAQ's TCP port. valve_socket: the CANopen valve's socket path.
+// heartbeat_timeout_s: give the shipped 0.05 where the heartbeat's loss is
+// what the test measures.
+inline std::string wire_config(const std::string& driver, int port, const std::string& valve_socket,
+                               double heartbeat_timeout_s = kWireMaxAge) {
+  std::string text = shipped_config();
+  text = edit(text, "\ndriver: sim\n", "\ndriver: " + driver + "\ndriver_start_timeout_s: 30\n");
+  if (port != 1502) text = edit(text, "port: 1502", "port: " + std::to_string(port));
+  text = edit(text, "response_timeout_s: 0\\.002", "response_timeout_s: 0.01");
+  text = edit(text, "max_sample_age_s: 0\\.0125", "max_sample_age_s: " + std::to_string(kWireMaxAge));
+  text = edit(text, "actual_max_age_s: 0\\.0125", "actual_max_age_s: " + std::to_string(kWireMaxAge));
+  text = edit(text, "socket_path: /run/rigctl/valve\\.sock", "socket_path: " + valve_socket);
+  text = edit(text, "heartbeat_timeout_s: 0\\.05", "heartbeat_timeout_s: " + std::to_string(heartbeat_timeout_s));
+  // The valve's consumer time for our heartbeat: during start-up that
+  // heartbeat comes from the normal-priority thread doing the SDO exchange.
+  text = edit(text, "  sdo_timeout_s: 0\\.1\n",
+              "  sdo_timeout_s: 2.0\n  startup_timeout_s: 30\n  valve_consumer_time_s: 1.0\n");
+  return text;
+}
+
+}  // namespace rigctl::test
