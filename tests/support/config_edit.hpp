@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <regex>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,16 @@ inline std::string edit(const std::string& text, const std::string& pattern, con
   std::string out = std::regex_replace(text, re, replacement, std::regex_constants::format_first_only);
   EXPECT_NE(out, text) << "pattern not found: " << pattern;
   return out;
+}
+
+// 1-based number of the first line of `text` containing `fragment`, 0 for none.
+inline int line_of(const std::string& text, const std::string& fragment) {
+  std::istringstream lines(text);
+  std::string line;
+  for (int n = 1; std::getline(lines, line); ++n) {
+    if (line.find(fragment) != std::string::npos) return n;
+  }
+  return 0;
 }
 
 // The ConfigError that loading and assembling `yaml` gives, "" when accepted.
