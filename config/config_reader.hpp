@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "config/kind_names.hpp"
+
 namespace rigctl {
 
 class ConfigError : public std::runtime_error {
@@ -39,6 +41,14 @@ class ConfigReader {
   bool boolean(const std::string& key);
   std::string text(const std::string& key);
   std::string choice(const std::string& key, const std::vector<std::string>& allowed);
+  // A kind (config/kind_names.hpp) by its name; an unknown name is an error
+  // naming the kind and listing the known names.
+  template <NamedKind Kind>
+  Kind kind(const std::string& key) {
+    const std::string name = text(key);
+    if (const auto k = kind_from_string<Kind>(name)) return *k;
+    fail(key, unknown_kind_message<Kind>(name));
+  }
   std::vector<double> numbers(const std::string& key, std::size_t min_count, std::size_t max_count,
                               double min = -std::numeric_limits<double>::infinity(),
                               double max = std::numeric_limits<double>::infinity());

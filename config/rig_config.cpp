@@ -46,77 +46,103 @@ TelemetryConfig read_telemetry(ConfigReader r) {
   return c;
 }
 
-ControllerConfig read_controller(ConfigReader r, const std::string& rig, double period_s) {
+PiConfig read_pi(ConfigReader& r, double period_s) {
+  PiConfig pi;
+  pi.kp = r.number("kp", 0.0, 1e6);
+  pi.ki = r.number("ki", 0.0, 1e6);
+  pi.output_limit = r.number("output_limit", 1e-6, 1e6);
+  pi.anti_windup = r.choice("anti_windup", {"conditional", "none"}) == "none" ? AntiWindup::kNone
+                                                                            : AntiWindup::kConditional;
+  pi.period_s = period_s;
+  return pi;
+}
+
+PvpConfig read_pvp(ConfigReader& r, double period_s) {
+  PvpConfig pvp;
+  pvp.ke = r.number("ke", 0.0, 1e4);
+  pvp.kv = r.number("kv", 0.0, 1e4);
+  pvp.kp = r.number("kp_v_per_bar", 0.0, 1e3) / 1e5;  // the paper's V/bar, to V/Pa
+  pvp.transient_pressure = r.boolean("transient_pressure");
+  pvp.tau_f = r.number("transient_tau_s", 1e-3, 1e3);
+  pvp.velocity_filter_tau = r.number("velocity_filter_tau_s", 0.0, 10.0);
+  pvp.output_limit = r.number("output_limit", 1e-6, 1e6);
+  pvp.period_s = period_s;
+  return pvp;
+}
+
+ControllerConfig read_controller(ConfigReader r, RigKind rig, double period_s) {
   ControllerConfig c;
-  // Each rig has the controller of its paper.
-  if (rig == "half_car") {
-    // Passive, the paper's fuzzy controller, or a baseline. Every
-    // controller's settings are required: `rigctl compare` runs them all.
-    c.type = r.choice("type", suspension_controller_types());
-    c.feedback = r.choice("feedback", {"z_s"});  // the regulated body heave (the other body states by their run-file names)
-    read_suspension_controller(r, c.suspension);
-    c.output = c.suspension.output_1;
-    r.reject_unknown_keys();
-    return c;
-  }
-  c.type = r.choice("type", {rig == "pneumatic_rotary" ? "pvp" : "pi"});
-  c.feedback = r.text("feedback");
-  c.output = r.text("output");
-  if (c.type == "pi") {
-    c.pi.kp = r.number("kp", 0.0, 1e6);
-    c.pi.ki = r.number("ki", 0.0, 1e6);
-    c.pi.output_limit = r.number("output_limit", 1e-6, 1e6);
-    c.pi.anti_windup = r.choice("anti_windup", {"conditional", "none"}) == "none" ? AntiWindup::kNone
-                                                                                : AntiWindup::kConditional;
-    c.pi.period_s = period_s;
-  } else {
-    c.pressure = r.text("pressure");
-    c.pvp.ke = r.number("ke", 0.0, 1e4);
-    c.pvp.kv = r.number("kv", 0.0, 1e4);
-    c.pvp.kp = r.number("kp_v_per_bar", 0.0, 1e3) / 1e5;  // the paper's V/bar, to V/Pa
-    c.pvp.transient_pressure = r.boolean("transient_pressure");
-    c.pvp.tau_f = r.number("transient_tau_s", 1e-3, 1e3);
-    c.pvp.velocity_filter_tau = r.number("velocity_filter_tau_s", 0.0, 10.0);
-    c.pvp.output_limit = r.number("output_limit", 1e-6, 1e6);
-    c.pvp.period_s = period_s;
+  // Each rig has the controller of its paper (the half car also the baselines).
+  c.type = read_controller_kind(r, "type", rig);
+  switch (c.type) {
+    case ControllerKind::kPi:
+      c.feedback = r.text("feedback");
+      c.output = r.text("output");
+      c.pi = read_pi(r, period_s);
+      break;
+    case ControllerKind::kPvp:
+      c.feedback = r.text("feedback");
+      c.output = r.text("output");
+      c.pressure = r.text("pressure");
+      c.pvp = read_pvp(r, period_s);
+      break;
+    case ControllerKind::kPassive:
+    case ControllerKind::kFuzzy:
+    case ControllerKind::kSkyhook:
+    case ControllerKind::kLqr:
+      // Every controller's settings are required: `rigctl compare` runs them all.
+      c.feedback = r.choice("feedback", {"z_s"});  // the regulated body heave (the other body states by their run-file names)
+      read_suspension_controller(r, c.suspension);
+      c.output = c.suspension.output_1;
+      break;
   }
   r.reject_unknown_keys();
   return c;
 }
 
+// The lead-in of ramp_steps and sine: hold at the start, then ramp to ramp_target.
+void read_lead_in(ConfigReader& r, ProfileConfig& c) {
+  // `start: measured` begins the lead-in where the feedback stands, so a
+  // run never starts with a jump in demand (the physical rig's choice).
+  if (r.has("start") && r.text("start") == "measured") {
+    c.start_from_measurement = true;
+  } else {
+    c.start = r.number("start", -10.0, 10.0);
+  }
+  c.hold_s = r.number("hold_s", 0.0, 1e5);
+  c.ramp_target = r.number("ramp_target", -10.0, 10.0);
+  c.ramp_rate = r.number("ramp_rate", 1e-6, 100.0);
+}
+
 ProfileConfig read_profile(ConfigReader r, const std::string& config_file) {
   ProfileConfig c;
-  c.type = r.choice("type", {"ramp_steps", "sine", "csv", "hold"});
+  c.type = r.kind<ProfileKind>("type");
   c.filter_tau_s = r.number("filter_tau_s", 0.0, 100.0);
-  if (c.type == "hold") {
-    // A constant demand (a regulator: the half car holds its body at rest
-    // while the road moves under it).
-    c.value = r.number("value", -10.0, 10.0);
-    c.duration_s = r.number("duration_s", 1e-3, 1e7);
-  } else if (c.type == "csv") {
-    const std::filesystem::path file = r.text("file");
-    c.csv_file = file.is_absolute() ? file.string()
-                                    : (std::filesystem::path(config_file).parent_path() / file).string();
-    c.csv_column = r.text("column");
-  } else {
-    // `start: measured` begins the lead-in where the feedback stands, so a
-    // run never starts with a jump in demand (the physical rig's choice).
-    if (r.has("start") && r.text("start") == "measured") {
-      c.start_from_measurement = true;
-    } else {
-      c.start = r.number("start", -10.0, 10.0);
+  switch (c.type) {
+    case ProfileKind::kHold:
+      // A constant demand (a regulator: the half car holds its body at rest
+      // while the road moves under it).
+      c.value = r.number("value", -10.0, 10.0);
+      c.duration_s = r.number("duration_s", 1e-3, 1e7);
+      break;
+    case ProfileKind::kCsv: {
+      const std::filesystem::path file = r.text("file");
+      c.csv_file = file.is_absolute() ? file.string()
+                                      : (std::filesystem::path(config_file).parent_path() / file).string();
+      c.csv_column = r.text("column");
+      break;
     }
-    c.hold_s = r.number("hold_s", 0.0, 1e5);
-    c.ramp_target = r.number("ramp_target", -10.0, 10.0);
-    c.ramp_rate = r.number("ramp_rate", 1e-6, 100.0);
-    if (c.type == "ramp_steps") {
+    case ProfileKind::kRampSteps:
+      read_lead_in(r, c);
       c.steps = r.numbers("steps", 1, 10000, -10.0, 10.0);
       c.step_hold_s = r.number("step_hold_s", 1e-3, 1e5);
-    } else {
+      break;
+    case ProfileKind::kSine:
+      read_lead_in(r, c);
       c.amplitude = r.number("amplitude", 0.0, 10.0);
       c.frequency_hz = r.number("frequency_hz", 1e-4, 1e3);
       c.cycles = r.number("cycles", 0.0, 1e7);
-    }
+      break;
   }
   r.reject_unknown_keys();
   return c;
@@ -155,8 +181,8 @@ RigConfig parse(ConfigReader root, const std::string& case_name) {
   RigConfig c;
   c.file = root.file();
   c.case_name = case_name;
-  c.rig = root.choice("rig", known_rig_kinds());
-  c.driver = root.choice("driver", {"sim", "modbus", "modbus_canopen"});
+  c.rig = root.kind<RigKind>("rig");
+  c.driver = root.kind<DriverKind>("driver");
   c.seed = static_cast<uint64_t>(root.integer("seed", 0, std::numeric_limits<int64_t>::max()));
   c.loop = read_loop(root.child("loop"));
   c.telemetry = read_telemetry(root.child("telemetry"));
@@ -170,19 +196,23 @@ RigConfig parse(ConfigReader root, const std::string& case_name) {
       c.faults.push_back(parse_fault_spec(text));
     }
   }
-  if (c.rig == "quarter_car") {
-    read_quarter_car_plant(root.child("plant"), c.quarter_car);
-  } else if (c.rig == "half_car") {
-    read_half_car_plant(root.child("plant"), c.half_car);
-    c.suspension_report = read_suspension_report(root.child("report"));
-    c.suspension_optimize = read_suspension_optimize(root.child("optimize"));
-  } else {
-    read_pneumatic_rotary_plant(root.child("plant"), c.pneumatic_rotary);
+  switch (c.rig) {
+    case RigKind::kQuarterCar:
+      read_quarter_car_plant(root.child("plant"), c.quarter_car);
+      break;
+    case RigKind::kPneumaticRotary:
+      read_pneumatic_rotary_plant(root.child("plant"), c.pneumatic_rotary);
+      break;
+    case RigKind::kHalfCar:
+      read_half_car_plant(root.child("plant"), c.half_car);
+      c.suspension_report = read_suspension_report(root.child("report"));
+      c.suspension_optimize = read_suspension_optimize(root.child("optimize"));
+      break;
   }
   c.sensors = read_converters(root.child("sensors"), true);
   c.dacs = read_converters(root.child("outputs"), false);
-  if (root.has("modbus") || c.driver != "sim") c.modbus = read_modbus_daq(root.child("modbus"), c.loop.period_s);
-  if (root.has("canopen") || c.driver == "modbus_canopen") c.canopen = read_canopen_valve(root.child("canopen"));
+  if (root.has("modbus") || uses_modbus_daq(c.driver)) c.modbus = read_modbus_daq(root.child("modbus"), c.loop.period_s);
+  if (root.has("canopen") || uses_canopen_valve(c.driver)) c.canopen = read_canopen_valve(root.child("canopen"));
   if (root.has("driver_start_timeout_s")) c.driver_start_timeout_s = root.number("driver_start_timeout_s", 0.01, 60.0);
   root.reject_unknown_keys();
   return c;

@@ -9,7 +9,12 @@
 #include <string>
 #include <vector>
 
+#include "config/controller_kind.hpp"
+#include "config/detector_kinds.hpp"
+#include "config/driver_kind.hpp"
 #include "config/operator_config.hpp"
+#include "config/profile_kind.hpp"
+#include "config/rig_kind.hpp"
 #include "config/suspension_controller_reader.hpp"
 #include "drivers/canopen/canopen_valve_config.hpp"
 #include "drivers/modbus/modbus_daq_config.hpp"
@@ -26,12 +31,6 @@
 
 namespace rigctl {
 
-// Rig kinds this build knows; others are a config error naming the list.
-inline const std::vector<std::string>& known_rig_kinds() {
-  static const std::vector<std::string> kinds{"quarter_car", "pneumatic_rotary", "half_car"};
-  return kinds;
-}
-
 struct LoopConfig {
   double period_s = 0.0025;
   OverrunPolicy overrun_policy = OverrunPolicy::kSkip;
@@ -46,7 +45,7 @@ struct TelemetryConfig {
 };
 
 struct ControllerConfig {
-  std::string type = "pi";  // pi (quarter_car) | pvp (pneumatic_rotary) | passive, fuzzy, skyhook, lqr (half_car)
+  ControllerKind type = ControllerKind::kPi;  // one of the rig's own (rig_of)
   std::string feedback;     // input channel name
   std::string output;       // output channel name (half_car: suspension.output_1 and _2)
   PiConfig pi;              // type pi; channel indices resolved when the rig is assembled
@@ -56,7 +55,7 @@ struct ControllerConfig {
 };
 
 struct ProfileConfig {
-  std::string type = "ramp_steps";  // ramp_steps | sine | csv | hold
+  ProfileKind type = ProfileKind::kRampSteps;
   double filter_tau_s = 0.0;
   // ramp_steps and sine; positions in the feedback channel's unit (m or rad)
   double start = 0.0, hold_s = 0.0, ramp_target = 0.0, ramp_rate = 0.0;
@@ -80,7 +79,7 @@ struct LimitConfig {
 // (tools/run/rig_assembly.cpp), with errors naming safety.detectors.NAME.
 struct DetectorConfig {
   std::string name;     // key under safety.detectors
-  std::string type;     // range | rate | tracking_error | valve_saturation | sample_age | overruns | open_circuit | stuck
+  DetectorKind type = DetectorKind::kRange;  // any but kInvalid (config/detector_kinds.hpp)
   std::string channel;  // input; valve_saturation and stuck: `output` goes to output; tracking_error: default controller.feedback
   std::string output;   // valve_saturation, stuck: the valve output
   double min = -std::numeric_limits<double>::infinity();
@@ -113,10 +112,8 @@ LimitAction limit_action_from_string(const std::string& s);
 struct RigConfig {
   std::string file;
   std::string case_name;  // the `cases:` entry applied, "" for none
-  std::string rig;
-  // sim: the simulated plant in process. modbus: sensors and valve output on
-  // a Modbus DAQ. modbus_canopen: sensors on the DAQ, valve on CANopen.
-  std::string driver = "sim";
+  RigKind rig = RigKind::kQuarterCar;
+  DriverKind driver = DriverKind::kSim;
   double driver_start_timeout_s = 2.0;  // hardware: first sample / valve operational within this
   uint64_t seed = 1;
   LoopConfig loop;

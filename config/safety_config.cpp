@@ -13,16 +13,10 @@ const std::vector<std::string>& action_names() {
   return names;
 }
 
-const std::vector<std::string>& detector_types() {
-  static const std::vector<std::string> types{"range", "rate", "tracking_error", "valve_saturation",
-                                              "sample_age", "overruns", "open_circuit", "stuck"};
-  return types;
-}
-
 DetectorConfig read_detector(ConfigReader r, const std::string& name) {
   DetectorConfig d;
   d.name = name;
-  d.type = r.choice("type", detector_types());
+  d.type = r.kind<DetectorKind>("type");
   d.action = limit_action_from_string(r.choice("action", action_names()));
   if (r.has("latch")) d.latch = r.boolean("latch");
   auto range = [&](const char* key) {
@@ -31,37 +25,55 @@ DetectorConfig read_detector(ConfigReader r, const std::string& name) {
     d.min = v[0];
     d.max = v[1];
   };
-  if (d.type == "range") {
-    d.channel = r.text("channel");
-    range("range");
-  } else if (d.type == "open_circuit") {
-    d.channel = r.text("channel");
-    range("rails");
-  } else if (d.type == "rate") {
-    d.channel = r.text("channel");
-    d.max = r.number("max", 0.0, kInf);
-  } else if (d.type == "tracking_error") {
-    if (r.has("channel")) d.channel = r.text("channel");
-    d.max = r.number("max", 0.0, kInf);
-  } else if (d.type == "valve_saturation") {
-    d.output = r.text("output");
-    d.max = r.number("level", 0.0, kInf);
-    d.duration_s = r.number("duration_s", 0.0, 3600.0);
-  } else if (d.type == "sample_age") {
-    d.max = r.number("max_s", 0.0, 3600.0);
-  } else if (d.type == "overruns") {
-    d.max_count = r.integer("max_count", 0, 1'000'000);
-    d.window_s = r.number("window_s", 1e-3, 3600.0);
-  } else {  // stuck
-    d.channel = r.text("channel");
-    d.output = r.text("output");
-    d.tolerance = r.number("tolerance", 0.0, kInf);
-    d.command_min = r.number("command_min", 0.0, kInf);
-    d.duration_s = r.number("duration_s", 1e-3, 3600.0);
-  }
-  // Persistence (debounce) for the types without a defining duration.
-  if (d.type != "valve_saturation" && d.type != "stuck" && r.has("duration_s")) {
-    d.duration_s = r.number("duration_s", 0.0, 3600.0);
+  // Persistence (debounce) for the kinds without a defining duration.
+  auto debounce = [&] {
+    if (r.has("duration_s")) d.duration_s = r.number("duration_s", 0.0, 3600.0);
+  };
+  switch (d.type) {
+    case DetectorKind::kRange:
+      d.channel = r.text("channel");
+      range("range");
+      debounce();
+      break;
+    case DetectorKind::kOpenCircuit:
+      d.channel = r.text("channel");
+      range("rails");
+      debounce();
+      break;
+    case DetectorKind::kRate:
+      d.channel = r.text("channel");
+      d.max = r.number("max", 0.0, kInf);
+      debounce();
+      break;
+    case DetectorKind::kTrackingError:
+      if (r.has("channel")) d.channel = r.text("channel");
+      d.max = r.number("max", 0.0, kInf);
+      debounce();
+      break;
+    case DetectorKind::kValveSaturation:
+      d.output = r.text("output");
+      d.max = r.number("level", 0.0, kInf);
+      d.duration_s = r.number("duration_s", 0.0, 3600.0);
+      break;
+    case DetectorKind::kSampleAge:
+      d.max = r.number("max_s", 0.0, 3600.0);
+      debounce();
+      break;
+    case DetectorKind::kOverruns:
+      d.max_count = r.integer("max_count", 0, 1'000'000);
+      d.window_s = r.number("window_s", 1e-3, 3600.0);
+      debounce();
+      break;
+    case DetectorKind::kStuck:
+      d.channel = r.text("channel");
+      d.output = r.text("output");
+      d.tolerance = r.number("tolerance", 0.0, kInf);
+      d.command_min = r.number("command_min", 0.0, kInf);
+      d.duration_s = r.number("duration_s", 1e-3, 3600.0);
+      break;
+    case DetectorKind::kInvalid:
+      // Not a configurable kind (KindNames<DetectorKind>::known): r.kind never returns it.
+      r.fail("type", "'invalid' is built for every input, not configured");
   }
   r.reject_unknown_keys();
   return d;

@@ -170,7 +170,7 @@ SuspensionReportConfig read_suspension_report(ConfigReader r) {
 SuspensionOptimizeConfig read_suspension_optimize(ConfigReader r) {
   SuspensionOptimizeConfig c;
   c.algorithm = r.choice("algorithm", {"isres", "crs2_lm"});
-  c.controller = r.choice("controller", suspension_controller_types());
+  c.controller = read_controller_kind(r, "controller", RigKind::kHalfCar);
   c.evaluations = static_cast<int>(r.integer("evaluations", 1, 1000000));
   c.seed = static_cast<uint64_t>(r.integer("seed", 0, std::numeric_limits<int64_t>::max()));
   c.duration_s = r.number("duration_s", 0.01, 3600.0);

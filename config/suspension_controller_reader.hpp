@@ -34,6 +34,7 @@
 #include <vector>
 
 #include "config/config_reader.hpp"
+#include "config/controller_kind.hpp"
 #include "rt/control/fuzzy_engine.hpp"
 #include "rt/control/fuzzy_suspension_controller.hpp"
 #include "rt/control/lqr_controller.hpp"
@@ -41,10 +42,13 @@
 
 namespace rigctl {
 
-// Controller types of the half car, in the order the report runs them.
-inline const std::vector<std::string>& suspension_controller_types() {
-  static const std::vector<std::string> types{"passive", "fuzzy", "skyhook", "lqr"};
-  return types;
+// The half car's controllers, in the order the report runs them.
+inline std::vector<ControllerKind> suspension_controllers() { return controllers_of(RigKind::kHalfCar); }
+// Their names, in that order: the report's table heads and JSON keys.
+inline std::vector<std::string> suspension_controller_types() {
+  std::vector<std::string> names;
+  for (const ControllerKind k : suspension_controllers()) names.emplace_back(to_string(k));
+  return names;
 }
 
 struct SuspensionControllerSettings {
@@ -95,7 +99,7 @@ inline const std::vector<std::string>& optimize_variable_names() {
 // of the weights), subject to peak |suspension travel| <= travel_limit.
 struct SuspensionOptimizeConfig {
   std::string algorithm = "crs2_lm";   // crs2_lm (constraint as a penalty) | isres (constraint native)
-  std::string controller = "passive";  // which controller runs during the search
+  ControllerKind controller = ControllerKind::kPassive;  // which controller runs during the search
   int evaluations = 300;               // simulation runs (the initial design not counted)
   uint64_t seed = 1;                   // NLopt's random seed: same seed, same search
   double duration_s = 10.0;            // [s] per evaluation

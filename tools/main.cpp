@@ -12,6 +12,7 @@
 #include "tools/diagnosis/diagnose_command.hpp"
 #include "tools/hidden_effects/make_run.hpp"
 #include "tools/runfile/log2csv.hpp"
+#include "tools/runfile/run_file_rig.hpp"
 #include "tools/suspension/optimize_command.hpp"
 #include "tools/rig_sim/rig_sim.hpp"
 #include "tools/run/run_command.hpp"
@@ -101,7 +102,7 @@ int main(int argc, char** argv) {
 
   rigctl::DiagnoseCommandOptions diag;
   auto* diag_cmd = app.add_subcommand("diagnose", "Model-discrepancy diagnosis of a run file (docs/run-files.md, docs/diagnosis.md)");
-  diag_cmd->add_option("--rig", diag.rig, "Rig kind: quarter_car, pneumatic_rotary, half_car, linear_axis, damper")->required();
+  diag_cmd->add_option("--rig", diag.rig, "Rig kind: " + rigctl::known_kind_names<rigctl::RunFileRig>())->required();
   diag_cmd->add_option("--data", diag.data_path, "Run file (CSV)")->required();
   diag_cmd->add_option("--config", diag.config_path, "Rig config (default: nominal parameters)");
   diag_cmd->add_option("--json", diag.json_path, "Write the diagnosis as JSON");
@@ -111,9 +112,10 @@ int main(int argc, char** argv) {
   diag_cmd->add_flag("--quiet", diag.quiet, "No progress on stderr");
 
   rigctl::MakeRunOptions make;
+  std::string make_rig;
   std::vector<std::string> effect_texts;
   auto* make_cmd = app.add_subcommand("make-run", "Hidden-effect generator: a run file from the simulated closed loop with chosen effects switched on (diagnosis tests)");
-  make_cmd->add_option("--rig", make.rig, "Rig kind: quarter_car, pneumatic_rotary, half_car")->required();
+  make_cmd->add_option("--rig", make_rig, "Rig kind: " + rigctl::known_kind_names<rigctl::RigKind>())->required();
   make_cmd->add_option("--config", make.config_path, "Rig config (default: config/<rig>.yaml)");
   make_cmd->add_option("--case", make.case_name, "Excitation case of the config (default: the rig's diagnosis case)");
   make_cmd->add_option("--effect", effect_texts, "CAUSE[:weak|strong|LEVEL], repeatable; none or absent: a clean run");
@@ -162,6 +164,7 @@ int main(int argc, char** argv) {
     }
     if (opcmd_cmd->parsed()) return rigctl::run_cmd_command(opcmd, std::cout, std::cerr);
     if (make_cmd->parsed()) {
+      make.rig = rigctl::parse_kind<rigctl::RigKind>(make_rig);
       for (const auto& e : effect_texts) {
         const auto colon = e.find(':');
         make.effects.emplace_back(e.substr(0, colon),

@@ -4,21 +4,6 @@
 
 namespace rigctl {
 
-std::string_view to_string(DetectorKind k) {
-  switch (k) {
-    case DetectorKind::kInvalid: return "invalid";
-    case DetectorKind::kRange: return "range";
-    case DetectorKind::kRate: return "rate";
-    case DetectorKind::kTrackingError: return "tracking_error";
-    case DetectorKind::kValveSaturation: return "valve_saturation";
-    case DetectorKind::kSampleAge: return "sample_age";
-    case DetectorKind::kOverruns: return "overruns";
-    case DetectorKind::kOpenCircuit: return "open_circuit";
-    case DetectorKind::kStuck: return "stuck";
-  }
-  return "unknown";
-}
-
 EventCode event_code(DetectorKind k) {
   switch (k) {
     case DetectorKind::kInvalid: return EventCode::kInputInvalid;
@@ -36,8 +21,18 @@ EventCode event_code(DetectorKind k) {
 
 namespace {
 bool uses_input(DetectorKind k) {
-  return k == DetectorKind::kInvalid || k == DetectorKind::kRange || k == DetectorKind::kRate ||
-         k == DetectorKind::kTrackingError || k == DetectorKind::kOpenCircuit || k == DetectorKind::kStuck;
+  switch (k) {
+    case DetectorKind::kInvalid:
+    case DetectorKind::kRange:
+    case DetectorKind::kRate:
+    case DetectorKind::kTrackingError:
+    case DetectorKind::kOpenCircuit:
+    case DetectorKind::kStuck: return true;
+    case DetectorKind::kValveSaturation:  // an output
+    case DetectorKind::kSampleAge:        // the sample's time stamp
+    case DetectorKind::kOverruns: return false;  // the loop's count
+  }
+  return false;
 }
 }  // namespace
 

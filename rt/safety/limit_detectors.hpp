@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "rt/safety/detector_kind.hpp"
 #include "rt/safety/limit_action.hpp"
 #include "rt/safety/limit_check.hpp"
 #include "rt/sample.hpp"
@@ -18,19 +19,6 @@
 
 namespace rigctl {
 
-enum class DetectorKind : uint8_t {
-  kInvalid,          // input not finite or flagged invalid by the driver
-  kRange,            // input outside [min, max]
-  kRate,             // |d input / dt| > max
-  kTrackingError,    // |demand - input| > max while the valve is driven
-  kValveSaturation,  // |output| >= max for duration_s while the valve is driven
-  kSampleAge,        // the sample time stamp has not advanced for more than max [s]
-  kOverruns,         // more than max_count loop overruns within window_s
-  kOpenCircuit,      // input at or beyond a rail (<= min or >= max): broken wire, LVDT at its rail
-  kStuck,            // input within `tolerance` for duration_s while |output| >= command_min
-};
-
-std::string_view to_string(DetectorKind k);
 EventCode event_code(DetectorKind k);
 
 struct DetectorSpec {

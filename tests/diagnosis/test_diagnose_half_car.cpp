@@ -123,10 +123,10 @@ class DiagnoseHalfCar : public ::testing::Test {
       std::lock_guard<std::mutex> lock(mutex_);
       if (!outcomes_[c.name].made) return;
     }
-    const auto rf = read_run_file((dir_ / (c.name + ".csv")).string(), run_file_columns("half_car"));
+    const auto rf = read_run_file((dir_ / (c.name + ".csv")).string(), run_file_columns(RunFileRig::kHalfCar));
     diag::RigModelOptions mo;
     mo.config_path = kConfig;
-    const auto model = diag::make_rig_model("half_car", rf, mo);
+    const auto model = diag::make_rig_model(RunFileRig::kHalfCar, rf, mo);
     diag::Diagnosis d = diag::diagnose(*model, {});
     std::lock_guard<std::mutex> lock(mutex_);
     outcomes_[c.name].d = std::move(d);

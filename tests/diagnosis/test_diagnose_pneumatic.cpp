@@ -71,10 +71,10 @@ std::string make_run_file(const Case& c) {
 Outcome make_and_diagnose(const Case& c) {
   Outcome o;
   try {
-    const auto rf = read_run_file(make_run_file(c), run_file_columns(kRig));
+    const auto rf = read_run_file(make_run_file(c), run_file_columns(RunFileRig::kPneumaticRotary));
     diag::RigModelOptions mo;
     mo.config_path = kConfig;
-    const auto model = diag::make_rig_model(kRig, rf, mo);
+    const auto model = diag::make_rig_model(RunFileRig::kPneumaticRotary, rf, mo);
     o.d = diag::diagnose(*model, {});
   } catch (const std::exception& e) {
     o.error = e.what();
@@ -96,7 +96,7 @@ std::vector<Outcome> run_all(const std::vector<Case>& cases) {
 }
 
 AppliedEffect truth_of(const std::string& cause, double level) {
-  const auto& gen = effect_generator(kRig);
+  const auto& gen = effect_generator(RigKind::kPneumaticRotary);
   RigConfig c = load_rig_config(kConfig, gen.excitation_case);
   gen.make_clean(c);
   return gen.apply(c, cause, level);
@@ -164,7 +164,7 @@ void expect_single_cause_found(const std::vector<std::string>& causes, double le
 }
 
 TEST(DiagnosePneumatic, EveryStrongEffectIsNamedWithItsSize) {
-  expect_single_cause_found(effect_generator(kRig).causes, 1.0, 0.10);
+  expect_single_cause_found(effect_generator(RigKind::kPneumaticRotary).causes, 1.0, 0.10);
 }
 
 // The confusable pair at about the paper's measured +-2 % level, the dead

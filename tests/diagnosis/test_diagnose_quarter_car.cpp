@@ -60,15 +60,15 @@ Outcome run_case(const Case& c, const std::string& dir) {
   Outcome o;
   try {
     MakeRunOptions m;
-    m.rig = "quarter_car";
+    m.rig = RigKind::kQuarterCar;
     m.config_path = RIGCTL_SOURCE_DIR "/config/quarter_car.yaml";
     m.effects = c.effects;
     m.seed = c.seed;
     m.out_csv = dir + "/" + c.name + ".csv";
     std::ostringstream quiet;
     o.applied = make_run(m, quiet);
-    const auto rf = read_run_file(m.out_csv, run_file_columns("quarter_car"));
-    const auto model = diag::make_rig_model("quarter_car", rf, {});
+    const auto rf = read_run_file(m.out_csv, run_file_columns(RunFileRig::kQuarterCar));
+    const auto model = diag::make_rig_model(RunFileRig::kQuarterCar, rf, {});
     o.diagnosis = diag::diagnose(*model, {});
   } catch (const std::exception& e) {
     o.error = e.what();

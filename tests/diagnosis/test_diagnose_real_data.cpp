@@ -16,7 +16,7 @@
 namespace rigctl {
 namespace {
 
-diag::Diagnosis run_diagnosis(const std::string& rig, const std::string& path) {
+diag::Diagnosis run_diagnosis(RunFileRig rig, const std::string& path) {
   const auto rf = read_run_file(path, run_file_columns(rig));
   const auto model = diag::make_rig_model(rig, rf, {});
   return diag::diagnose(*model, {});
@@ -34,7 +34,7 @@ void expect_near_rel(double v, double ref, double rel, const char* what) {
 }
 
 TEST(DiagnoseRealData, EmpsNamesCoulombThenAsymmetricFriction) {
-  const auto d = run_diagnosis("linear_axis", RIGCTL_TEST_DATA "/emps_estimation.csv");
+  const auto d = run_diagnosis(RunFileRig::kLinearAxis, RIGCTL_TEST_DATA "/emps_estimation.csv");
   ASSERT_GE(d.causes.size(), 2u);
   EXPECT_EQ(d.cause, "coulomb_friction");
   EXPECT_EQ(d.causes[0].cause, "coulomb_friction");
@@ -58,7 +58,7 @@ TEST(DiagnoseRealData, EmpsNamesCoulombThenAsymmetricFriction) {
 }
 
 TEST(DiagnoseRealData, MrDamperNamesHysteresisAndCommandLag) {
-  const auto d = run_diagnosis("damper", RIGCTL_TEST_DATA "/mr_damper_random_50.csv");
+  const auto d = run_diagnosis(RunFileRig::kDamper, RIGCTL_TEST_DATA "/mr_damper_random_50.csv");
   bool hyst = false, lag = false;
   for (const auto& c : d.causes) {
     if (c.cause == "hysteresis") hyst = c.gain_percent_points > 1.0;

@@ -32,7 +32,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
   rigctl::RunFileOptions options;
   try {
     const char* rig = kRigs[mode & 7];
-    if (rig[0] != '\0') options = rigctl::run_file_columns(rig);
+    if (rig[0] != '\0') options = rigctl::run_file_columns(rigctl::run_file_rig_from_string(rig));
   } catch (const rigctl::RunFileError&) {
     return 0;  // the unknown kind "x": the documented error
   }

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <regex>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,16 @@ inline std::string edit(const std::string& text, const std::string& pattern, con
 // simulated (test_fault_matrix's OverrunBurstStopsTheRigUnderControl).
 inline std::string without_overrun_stop(const std::string& text) {
   return edit(text, "(overrun_burst: \\{[^}]*action: )stop\\}", "$1indicate}");
+}
+
+// 1-based number of the first line of `text` containing `fragment`, 0 for none.
+inline int line_of(const std::string& text, const std::string& fragment) {
+  std::istringstream lines(text);
+  std::string line;
+  for (int n = 1; std::getline(lines, line); ++n) {
+    if (line.find(fragment) != std::string::npos) return n;
+  }
+  return 0;
 }
 
 // The ConfigError that loading and assembling `yaml` gives, "" when accepted.

@@ -95,6 +95,28 @@ TEST_F(CliTest, BadConfigIsAClearErrorAndNothingRuns) {
   EXPECT_FALSE(fs::exists(path("x.lcm"))) << "the rig must not start";
 }
 
+// Kinds named on the command line are parsed once, at the edge, and an
+// unknown one is refused with the known kinds listed (config/kind_names.hpp).
+TEST_F(CliTest, UnknownRigKindOnTheCommandLineListsTheKnownKinds) {
+  const auto make = run_command(kRigctl + " make-run --rig bicycle --out " + path("m.csv"));
+  EXPECT_EQ(make.exit_code, 1) << make.output;
+  EXPECT_NE(make.output.find("unknown rig kind 'bicycle' (known: quarter_car, pneumatic_rotary, half_car)"),
+            std::string::npos)
+      << make.output;
+  EXPECT_FALSE(fs::exists(path("m.csv")));
+  // diagnose knows the run-file contract's rigs, beyond the three rigctl runs;
+  // an unknown one is bad input (docs/run-files.md 2.2: exit 2).
+  const auto diagnose = run_command(kRigctl + " diagnose --rig bicycle --data " + path("none.csv"));
+  EXPECT_EQ(diagnose.exit_code, 2) << diagnose.output;
+  EXPECT_NE(diagnose.output.find("unknown rig kind 'bicycle' (known: quarter_car, pneumatic_rotary, half_car, "
+                                 "linear_axis, damper)"),
+            std::string::npos)
+      << diagnose.output;
+  const auto help = run_command(kRigctl + " diagnose --help");
+  EXPECT_NE(help.output.find("quarter_car, pneumatic_rotary, half_car, linear_axis, damper"), std::string::npos)
+      << help.output;
+}
+
 TEST_F(CliTest, LimitTripMakesTheRigSafeAndSaysWhy) {
   // A stroke limit inside the ramp's travel: the run must stop faulted there.
   std::string text = read_file(kConfig);

@@ -190,8 +190,8 @@ TEST_F(HalfCarRig, OptimizeRefusesAnInitialDesignOutsideItsBounds) {
 
 TEST(HalfCarConfig, ShippedConfigLoadsWithTheProposedHalfCar) {
   const auto c = load_rig_config(kConfig);
-  EXPECT_EQ(c.rig, "half_car");
-  EXPECT_EQ(c.controller.type, "fuzzy");
+  EXPECT_EQ(c.rig, RigKind::kHalfCar);
+  EXPECT_EQ(c.controller.type, ControllerKind::kFuzzy);
   EXPECT_EQ(c.half_car.plane, HalfCarPlane::kPitch);
   EXPECT_DOUBLE_EQ(c.half_car.mass_body, 1080.0);
   EXPECT_DOUBLE_EQ(c.half_car.spring_1, 80000.0);
@@ -200,12 +200,12 @@ TEST(HalfCarConfig, ShippedConfigLoadsWithTheProposedHalfCar) {
   EXPECT_DOUBLE_EQ(c.half_car.road.bump.wavelength, 0.20);
   EXPECT_DOUBLE_EQ(c.half_car.speed, 20.0);
   EXPECT_DOUBLE_EQ(c.suspension_report.settling_band_fraction, 0.05);  // per cent converted
-  EXPECT_EQ(c.profile.type, "hold");
-  for (const auto& type : suspension_controller_types()) {
+  EXPECT_EQ(c.profile.type, ProfileKind::kHold);
+  for (const ControllerKind type : suspension_controllers()) {
     RigConfig k = c;
     k.controller.type = type;
     const AssembledRig rig = assemble_rig(k);
-    EXPECT_EQ(rig.controller->name(), type);
+    EXPECT_EQ(rig.controller->name(), to_string(type));
     EXPECT_EQ(rig.setpoint_name, "z_s_ref");
     EXPECT_DOUBLE_EQ(rig.profile_duration_s, 10.0);
   }
@@ -218,7 +218,7 @@ TEST(HalfCarConfig, EveryCaseLoadsAndAssemblesEveryController) {
   }
   for (const auto& name : names) {
     const auto c = load_rig_config(kConfig, name);
-    for (const auto& type : suspension_controller_types()) {
+    for (const ControllerKind type : suspension_controllers()) {
       RigConfig k = c;
       k.controller.type = type;
       EXPECT_NO_THROW(assemble_rig(k)) << name << " " << type;
@@ -317,7 +317,7 @@ TEST(HalfCarConfig, BadKeysGiveClearErrorsNamingTheKey) {
                {"plant.road.bump.amplitude_m", "got -0.05"});
   expect_config_error(edit(shipped, "  vehicle_speed_m_s: 20.0 ", "  vehicle_speed_m_s: fast "),
                {"plant.vehicle_speed_m_s", "expected a number", "'fast'"});
-  expect_config_error(edit(shipped, "  type: fuzzy ", "  type: pid "), {"controller.type", "unknown value 'pid'", "skyhook"});
+  expect_config_error(edit(shipped, "  type: fuzzy ", "  type: pid "), {"controller.type", "unknown controller 'pid'", "skyhook"});
   expect_config_error(edit(shipped, "  force_limit_n: 2000.0", "  force_limit_n: 8000.0"),
                {"controller.force_limit_n", "outputs.f_1.range"});
   expect_config_error(edit(shipped, "  output_2: f_2 ", "  output_2: f_9 "), {"controller.output_2", "unknown output channel 'f_9'"});

@@ -24,17 +24,18 @@ std::string one_line(std::string s) {
 int run_diagnose(const DiagnoseCommandOptions& o, std::ostream& out, std::ostream& err) {
   diag::Diagnosis d;
   try {
-    auto cols = run_file_columns(o.rig);
+    const RunFileRig rig = run_file_rig_from_string(o.rig);
+    auto cols = run_file_columns(rig);
     cols.drop_bad_rows = o.drop_bad_rows;
     const RunFile run = read_run_file(o.data_path, cols);
-    if (const auto r = run.meta("rig"); r && *r != o.rig)
+    if (const auto r = run.meta("rig"); r && *r != to_string(rig))
       throw RunFileError(o.data_path + ": the run file says '# rig: " + *r + "' but --rig is " + o.rig);
     if (run.dropped_rows > 0) err << "diagnose: " << run.dropped_rows << " bad rows dropped\n";
     if (run.resampled) err << "diagnose: jittered time stamps resampled to the median step " << run.dt << " s\n";
     diag::RigModelOptions mo;
     mo.config_path = o.config_path;
     mo.decimate = o.decimate;
-    const auto model = diag::make_rig_model(o.rig, run, mo);
+    const auto model = diag::make_rig_model(rig, run, mo);
     diag::DiagnoseOptions dopt;
     dopt.progress = o.quiet ? nullptr : &err;
     d = diag::diagnose(*model, dopt);

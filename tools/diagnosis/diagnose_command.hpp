@@ -7,6 +7,8 @@
 namespace rigctl {
 
 struct DiagnoseCommandOptions {
+  // --rig as given: run_diagnose parses it first (an unknown rig kind is bad
+  // input, exit 2, like a bad run file).
   std::string rig;
   std::string data_path;
   std::string config_path;  // optional

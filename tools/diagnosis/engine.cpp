@@ -103,7 +103,7 @@ Diagnosis diagnose(const RigModel& model, const DiagnoseOptions& opt) {
                                     << std::defaultfloat << " s] " << s << std::endl;
   };
   Diagnosis d;
-  d.rig = model.rig();
+  d.rig = to_string(model.rig());
   const auto effects = model.effects();
   const Layout L = layout_of(model, effects);
   const auto& outs = model.outputs();

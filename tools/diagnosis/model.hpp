@@ -45,7 +45,7 @@ struct Output {
 class RigModel {
  public:
   virtual ~RigModel() = default;
-  virtual std::string rig() const = 0;
+  virtual RunFileRig rig() const = 0;
   virtual const std::vector<Output>& outputs() const = 0;
   virtual const std::vector<double>& time() const = 0;
   virtual std::vector<ParamSpec> baseline() const = 0;
@@ -78,6 +78,6 @@ struct RigModelOptions {
 
 // Builds the rig's model over a checked run file; throws RunFileError for bad
 // input (missing metadata the replay needs, ...).
-std::unique_ptr<RigModel> make_rig_model(const std::string& rig, const RunFile& run, const RigModelOptions& options);
+std::unique_ptr<RigModel> make_rig_model(RunFileRig rig, const RunFile& run, const RigModelOptions& options);
 
 }  // namespace rigctl::diag

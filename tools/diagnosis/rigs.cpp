@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <stdexcept>
 
 #include "tools/diagnosis/model.hpp"
 #include "tools/diagnosis/rigs.hpp"
@@ -46,7 +47,7 @@ class LinearAxisModel : public RigModel {
     outputs_ = {{"u", run.col("u")}, {"x", run.col("x")}};
     vel_ = central_diff(run.col("x"), dt_);
   }
-  std::string rig() const override { return "linear_axis"; }
+  RunFileRig rig() const override { return RunFileRig::kLinearAxis; }
   const std::vector<Output>& outputs() const override { return outputs_; }
   const std::vector<double>& time() const override { return t_; }
   std::vector<ParamSpec> baseline() const override {
@@ -184,7 +185,7 @@ class DamperModel : public RigModel {
         }
     for (int p = 0; p < 3; ++p) ls_[p] = b[p] / A[p][p];
   }
-  std::string rig() const override { return "damper"; }
+  RunFileRig rig() const override { return RunFileRig::kDamper; }
   const std::vector<Output>& outputs() const override { return outputs_; }
   const std::vector<double>& time() const override { return t_; }
   std::vector<ParamSpec> baseline() const override {
@@ -264,13 +265,24 @@ class DamperModel : public RigModel {
 
 }  // namespace
 
-std::unique_ptr<RigModel> make_rig_model(const std::string& rig, const RunFile& run, const RigModelOptions& o) {
-  if (rig == "linear_axis") return std::make_unique<LinearAxisModel>(run, o);
-  if (rig == "damper") return std::make_unique<DamperModel>(run, o);
-  if (rig == "quarter_car") return make_quarter_car_model(run, o);
-  if (rig == "pneumatic_rotary") return make_pneumatic_rotary_model(run, o);
-  if (rig == "half_car") return make_half_car_model(run, o);
-  throw RunFileError("unknown rig kind '" + rig + "'");
+RigConfig load_replay_config(const std::string& path, RigKind rig) {
+  RigConfig config = load_rig_config(path);
+  if (config.rig != rig) {
+    throw RunFileError("--config is a '" + std::string(to_string(config.rig)) + "' config, not " +
+                       std::string(to_string(rig)));
+  }
+  return config;
+}
+
+std::unique_ptr<RigModel> make_rig_model(RunFileRig rig, const RunFile& run, const RigModelOptions& o) {
+  switch (rig) {
+    case RunFileRig::kLinearAxis: return std::make_unique<LinearAxisModel>(run, o);
+    case RunFileRig::kDamper: return std::make_unique<DamperModel>(run, o);
+    case RunFileRig::kQuarterCar: return make_quarter_car_model(run, o);
+    case RunFileRig::kPneumaticRotary: return make_pneumatic_rotary_model(run, o);
+    case RunFileRig::kHalfCar: return make_half_car_model(run, o);
+  }
+  throw std::logic_error("make_rig_model: rig kind out of range");
 }
 
 }  // namespace rigctl::diag

@@ -4,9 +4,14 @@
 
 #include <memory>
 
+#include "config/rig_config.hpp"
 #include "tools/diagnosis/model.hpp"
 
 namespace rigctl::diag {
+
+// The rig config at `path` for a replay of `rig`: a RunFileError (bad
+// input) when it is another rig's config.
+RigConfig load_replay_config(const std::string& path, RigKind rig);
 
 // tools/diagnosis/models/quarter_car.cpp: seed 000's rig, two sub-models in one (the
 // actuator in the PI loop, the suspension driven by the measured road).

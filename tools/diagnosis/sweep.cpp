@@ -34,7 +34,8 @@ std::string level_name(double level) {
 }  // namespace
 
 SweepResult run_sweep(const SweepOptions& o, const std::atomic<bool>& stop, std::ostream& progress) {
-  const RigEffectGenerator& gen = effect_generator(o.rig);
+  const RigKind rig = parse_kind<RigKind>(o.rig);
+  const RigEffectGenerator& gen = effect_generator(rig);
   SweepResult r;
   r.labels.push_back("none");
   for (const auto& c : gen.causes) r.labels.push_back(c);
@@ -65,7 +66,7 @@ SweepResult run_sweep(const SweepOptions& o, const std::atomic<bool>& stop, std:
       const auto start = std::chrono::steady_clock::now();
       try {
         MakeRunOptions mr;
-        mr.rig = o.rig;
+        mr.rig = rig;
         mr.config_path = o.config_path;
         if (j.truth != "none") mr.effects.emplace_back(j.truth, j.level);
         mr.seed = j.seed;
@@ -73,8 +74,8 @@ SweepResult run_sweep(const SweepOptions& o, const std::atomic<bool>& stop, std:
         mr.out_csv = dir + "/run-" + std::to_string(i) + ".csv";
         std::ostringstream quiet;
         make_run(mr, quiet);
-        const auto rf = read_run_file(mr.out_csv, run_file_columns(o.rig));
-        const auto model = diag::make_rig_model(o.rig, rf, {});
+        const auto rf = read_run_file(mr.out_csv, run_file_columns(run_file_rig(rig)));
+        const auto model = diag::make_rig_model(run_file_rig(rig), rf, {});
         const auto d = diag::diagnose(*model, {});
         cell.named = d.cause;
         if (!d.causes.empty()) cell.gain = d.causes.front().gain_percent_points;

@@ -14,7 +14,7 @@
 namespace rigctl {
 
 struct SweepOptions {
-  std::string rig = "quarter_car";
+  std::string rig = "quarter_car";    // a rig kind's name (config/rig_kind.hpp), parsed by run_sweep
   std::string config_path;             // default config/<rig>.yaml
   std::vector<std::string> causes;     // empty: every cause id of the rig
   std::vector<double> levels{0.35, 1.0};

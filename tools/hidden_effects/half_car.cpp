@@ -99,7 +99,7 @@ AppliedEffect apply(RigConfig& c, const std::string& cause, double level) {
 
 const RigEffectGenerator& half_car_effect_generator() {
   static const RigEffectGenerator g{
-      "half_car",
+      RigKind::kHalfCar,
       {"actuator_lag", "tyre_liftoff", "damper_asymmetry", "sensor_delay"},
       "diagnosis",
       make_clean,

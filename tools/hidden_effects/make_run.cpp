@@ -21,20 +21,23 @@ double parse_effect_level(const std::string& text) {
   return *v;
 }
 
-const RigEffectGenerator& effect_generator(const std::string& rig) {
-  if (rig == "quarter_car") return quarter_car_effect_generator();
-  if (rig == "pneumatic_rotary") return pneumatic_rotary_effect_generator();
-  if (rig == "half_car") return half_car_effect_generator();
-  throw std::invalid_argument("no hidden-effect generator for rig kind '" + rig +
-                              "' (quarter_car, pneumatic_rotary, half_car)");
+const RigEffectGenerator& effect_generator(RigKind rig) {
+  switch (rig) {
+    case RigKind::kQuarterCar: return quarter_car_effect_generator();
+    case RigKind::kPneumaticRotary: return pneumatic_rotary_effect_generator();
+    case RigKind::kHalfCar: return half_car_effect_generator();
+  }
+  throw std::logic_error("effect_generator: rig kind out of range");
 }
+
+const RigEffectGenerator& effect_generator(const std::string& rig) { return effect_generator(parse_kind<RigKind>(rig)); }
 
 namespace {
 
 void write_truth(const std::string& path, const MakeRunOptions& o, const std::vector<AppliedEffect>& applied) {
   std::ofstream f(path);
   if (!f) throw std::runtime_error("cannot write the truth file '" + path + "'");
-  f << "{\n  \"rig\": " << json_string(o.rig) << ",\n  \"seed\": " << o.seed << ",\n  \"effects\": [";
+  f << "{\n  \"rig\": " << json_string(std::string(to_string(o.rig))) << ",\n  \"seed\": " << o.seed << ",\n  \"effects\": [";
   for (std::size_t i = 0; i < applied.size(); ++i) {
     const auto& a = applied[i];
     f << (i ? ",\n" : "\n") << "    {\"cause\": " << json_string(a.cause) << ", \"level\": " << json_number(a.level)
@@ -55,13 +58,15 @@ void write_truth(const std::string& path, const MakeRunOptions& o, const std::ve
 std::vector<AppliedEffect> make_run(const MakeRunOptions& o, std::ostream& progress) {
   const RigEffectGenerator& gen = effect_generator(o.rig);
   if (o.out_csv.empty()) throw std::invalid_argument("make-run needs an output run file (--out)");
-  const std::string config_path = o.config_path.empty() ? "config/" + o.rig + ".yaml" : o.config_path;
+  const std::string config_path =
+      o.config_path.empty() ? "config/" + std::string(to_string(o.rig)) + ".yaml" : o.config_path;
   const std::string case_name = o.case_name.empty() ? gen.excitation_case : o.case_name;
   RigConfig config = load_rig_config(config_path, case_name);
   if (config.rig != o.rig) {
-    throw std::invalid_argument("config '" + config_path + "' is a '" + config.rig + "' rig, not '" + o.rig + "'");
+    throw std::invalid_argument("config '" + config_path + "' is a '" + std::string(to_string(config.rig)) +
+                                "' rig, not '" + std::string(to_string(o.rig)) + "'");
   }
-  config.driver = "sim";  // the generator never drives hardware
+  config.driver = DriverKind::kSim;  // the generator never drives hardware
   config.seed = static_cast<uint64_t>(o.seed);
   config.telemetry.lcm_url = "memq://";
   // Sensor effects (offset, delay) are the same for every rig kind.

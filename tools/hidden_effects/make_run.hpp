@@ -35,7 +35,7 @@ struct AppliedEffect {
 
 // One rig kind's part of the generator (tools/hidden_effects/<rig>.cpp).
 struct RigEffectGenerator {
-  std::string rig;
+  RigKind rig;
   std::vector<std::string> causes;  // every contract cause id of the rig except "none"
   std::string excitation_case;      // `cases:` entry of the rig's shipped config used for diagnosis runs
   // Switches off every plant effect the diagnosis library covers (the baseline
@@ -45,11 +45,14 @@ struct RigEffectGenerator {
   AppliedEffect (*apply)(RigConfig& config, const std::string& cause, double level);
 };
 
-// Registry: quarter_car, pneumatic_rotary, half_car. Throws std::invalid_argument for another rig.
+// Registry: one generator per rig kind.
+const RigEffectGenerator& effect_generator(RigKind rig);
+// The same by the rig kind's name (callers holding a config file's name);
+// throws std::invalid_argument naming the known rig kinds for another name.
 const RigEffectGenerator& effect_generator(const std::string& rig);
 
 struct MakeRunOptions {
-  std::string rig;
+  RigKind rig = RigKind::kQuarterCar;
   std::string config_path;  // default: config/<rig>.yaml beside the binary's source tree
   std::string case_name;    // default: the generator's excitation_case
   std::vector<std::pair<std::string, double>> effects;  // cause id, level

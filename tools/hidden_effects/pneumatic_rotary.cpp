@@ -113,7 +113,7 @@ AppliedEffect apply(RigConfig& c, const std::string& cause, double level) {
 
 const RigEffectGenerator& pneumatic_rotary_effect_generator() {
   static const RigEffectGenerator g{
-      "pneumatic_rotary",
+      RigKind::kPneumaticRotary,
       {"bladder_hysteresis", "coulomb_friction", "polytropic_exponent", "valve_null_offset", "valve_deadband",
        "sensor_delay"},
       "diagnosis",

@@ -78,9 +78,15 @@ AppliedEffect apply(RigConfig& c, const std::string& cause, double level) {
     // a run that does: the demand gets a wheel-hop burst, the tyre cannot
     // pull (weak: part of the pull is lost, a tyre glued by its tread).
     // The `diagnosis` case's table with a wheel-hop burst added (beside it).
-    if (c.profile.type == "csv") {
-      c.profile.csv_file =
-          (std::filesystem::path(c.profile.csv_file).parent_path() / "quarter_car_liftoff_demand.csv").string();
+    switch (c.profile.type) {
+      case ProfileKind::kCsv:
+        c.profile.csv_file =
+            (std::filesystem::path(c.profile.csv_file).parent_path() / "quarter_car_liftoff_demand.csv").string();
+        break;
+      case ProfileKind::kRampSteps:  // no table to swap: the tyre alone
+      case ProfileKind::kSine:
+      case ProfileKind::kHold:
+        break;
     }
     h.tyre_pull_loss = std::min(1.0, level);
     a.truth = {{"pull_loss", h.tyre_pull_loss}};
@@ -108,7 +114,7 @@ AppliedEffect apply(RigConfig& c, const std::string& cause, double level) {
 
 const RigEffectGenerator& quarter_car_effect_generator() {
   static const RigEffectGenerator g{
-      "quarter_car",
+      RigKind::kQuarterCar,
       {"bearing_friction", "actuator_seal_friction", "cross_port_leakage", "valve_deadband", "entrained_air",
        "sensor_delay", "sensor_offset", "tyre_liftoff", "damper_asymmetry"},
       "diagnosis",

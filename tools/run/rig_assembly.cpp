@@ -1,5 +1,7 @@
 #include "tools/run/rig_assembly.hpp"
 
+#include <stdexcept>
+
 #include "config/config_reader.hpp"
 #include "drivers/hardware_driver.hpp"
 #include "drivers/sim/sim_driver.hpp"
@@ -66,16 +68,18 @@ std::vector<SensorSpec> dac_specs(const RigConfig& c, const std::vector<ChannelI
 }  // namespace
 
 std::unique_ptr<SimulatedPlant> make_plant(const RigConfig& c) {
-  if (c.rig == "quarter_car") return std::make_unique<QuarterCarPlant>(c.quarter_car);
-  if (c.rig == "half_car") return std::make_unique<HalfCarPlant>(c.half_car);
-  return std::make_unique<PneumaticRotaryPlant>(c.pneumatic_rotary);
+  switch (c.rig) {
+    case RigKind::kQuarterCar: return std::make_unique<QuarterCarPlant>(c.quarter_car);
+    case RigKind::kPneumaticRotary: return std::make_unique<PneumaticRotaryPlant>(c.pneumatic_rotary);
+    case RigKind::kHalfCar: return std::make_unique<HalfCarPlant>(c.half_car);
+  }
+  throw std::logic_error("make_plant: rig kind out of range");
 }
 
 namespace {
 
-std::unique_ptr<Driver> make_hardware_driver(const RigConfig& c) {
-  std::optional<CanopenValveConfig> valve;
-  if (c.driver == "modbus_canopen") valve = c.canopen;
+// The Modbus DAQ, with the valve on CANopen when `valve` is given.
+std::unique_ptr<Driver> make_hardware_driver(const RigConfig& c, const std::optional<CanopenValveConfig>& valve) {
   try {
     return std::make_unique<HardwareDriver>(*c.modbus, valve, c.driver_start_timeout_s);
   } catch (const std::invalid_argument& e) {
@@ -83,8 +87,7 @@ std::unique_ptr<Driver> make_hardware_driver(const RigConfig& c) {
   }
 }
 
-std::unique_ptr<Driver> make_driver(const RigConfig& c) {
-  if (c.driver != "sim") return make_hardware_driver(c);
+std::unique_ptr<Driver> make_sim_driver(const RigConfig& c) {
   auto plant = make_plant(c);
   auto sensors = sensor_specs(c, plant->signals());
   auto dacs = dac_specs(c, plant->commands());
@@ -92,6 +95,15 @@ std::unique_ptr<Driver> make_driver(const RigConfig& c) {
   std::vector<double> safe(plant->commands().size(), 0.0);
   return std::make_unique<SimDriver>(std::move(plant), std::move(sensors), std::move(dacs), c.loop.period_s, c.seed,
                                      std::move(safe));
+}
+
+std::unique_ptr<Driver> make_driver(const RigConfig& c) {
+  switch (c.driver) {
+    case DriverKind::kSim: return make_sim_driver(c);
+    case DriverKind::kModbus: return make_hardware_driver(c, std::nullopt);
+    case DriverKind::kModbusCanopen: return make_hardware_driver(c, c.canopen);
+  }
+  throw std::logic_error("make_driver: driver kind out of range");
 }
 
 int required_input(const RigConfig& c, const ChannelLayout& layout, const std::string& key, const std::string& name) {
@@ -135,91 +147,108 @@ std::unique_ptr<Controller> make_suspension_controller(const RigConfig& c, const
   // The output converters must pass the largest force the controller sends.
   for (const auto& name : {s.output_1, s.output_2}) {
     const auto it = c.dacs.find(name);
-    if (c.driver == "sim" && it != c.dacs.end() &&
+    if (is_simulated(c.driver) && it != c.dacs.end() &&
         (it->second.range_min > -s.force_limit || it->second.range_max < s.force_limit)) {
       config_fail(c, "controller.force_limit_n", "+-" + std::to_string(s.force_limit) + " N is outside outputs." +
                                                      name + ".range");
     }
   }
   const LeverArms lever{half_car_lever_arm(c.half_car, 0), half_car_lever_arm(c.half_car, 1)};
-  const auto& type = c.controller.type;
   try {
-    if (type == "passive") return std::make_unique<PassiveSuspensionController>(ch);
-    if (type == "fuzzy") {
-      FuzzySuspensionConfig f;
-      f.engine = s.fuzzy;
-      f.first_input = s.fuzzy_first_input;
-      f.force_limit = s.force_limit;
-      f.lever_arm = lever;
-      f.channels = ch;
-      return std::make_unique<FuzzySuspensionController>(f);
+    switch (c.controller.type) {
+      case ControllerKind::kPassive: return std::make_unique<PassiveSuspensionController>(ch);
+      case ControllerKind::kFuzzy: {
+        FuzzySuspensionConfig f;
+        f.engine = s.fuzzy;
+        f.first_input = s.fuzzy_first_input;
+        f.force_limit = s.force_limit;
+        f.lever_arm = lever;
+        f.channels = ch;
+        return std::make_unique<FuzzySuspensionController>(f);
+      }
+      case ControllerKind::kSkyhook: {
+        SkyhookConfig k;
+        k.c_sky = s.skyhook_c_sky;
+        k.force_limit = s.force_limit;
+        k.lever_arm = lever;
+        k.channels = ch;
+        return std::make_unique<SkyhookController>(k);
+      }
+      case ControllerKind::kLqr: {
+        LqrConfig q = LqrConfig::from_design(c.half_car, s.lqr, s.force_limit);
+        q.channels = ch;
+        return std::make_unique<LqrController>(q);
+      }
+      case ControllerKind::kPi:
+      case ControllerKind::kPvp:
+        break;  // not the half car's: the loader refuses them there (rig_of)
     }
-    if (type == "skyhook") {
-      SkyhookConfig k;
-      k.c_sky = s.skyhook_c_sky;
-      k.force_limit = s.force_limit;
-      k.lever_arm = lever;
-      k.channels = ch;
-      return std::make_unique<SkyhookController>(k);
-    }
-    LqrConfig q = LqrConfig::from_design(c.half_car, s.lqr, s.force_limit);
-    q.channels = ch;
-    return std::make_unique<LqrController>(q);
   } catch (const std::exception& e) {
-    config_fail(c, "controller." + type, e.what());
+    config_fail(c, "controller." + std::string(to_string(c.controller.type)), e.what());
   }
+  throw std::logic_error("make_suspension_controller: " + std::string(to_string(c.controller.type)) +
+                         " is not a half-car controller");
 }
 
-std::unique_ptr<Controller> make_controller(const RigConfig& c, const ChannelLayout& layout) {
-  if (c.rig == "half_car") return make_suspension_controller(c, layout);
+// The output of the single-output controllers (pi, pvp).
+int controller_output(const RigConfig& c, const ChannelLayout& layout) {
   const int output = layout.output_index(c.controller.output);
   if (output < 0) {
     config_fail(c, "controller.output", "unknown output channel '" + c.controller.output + "' (outputs: " +
                                              channel_list(layout.outputs) + ")");
   }
-  if (c.controller.type == "pi") {
-    PiConfig pi = c.controller.pi;
-    pi.feedback_input = required_input(c, layout, "controller.feedback", c.controller.feedback);
-    pi.output_index = output;
-    return std::make_unique<PiController>(pi);
+  return output;
+}
+
+std::unique_ptr<Controller> make_controller(const RigConfig& c, const ChannelLayout& layout) {
+  switch (c.controller.type) {
+    case ControllerKind::kPi: {
+      const int output = controller_output(c, layout);
+      PiConfig pi = c.controller.pi;
+      pi.feedback_input = required_input(c, layout, "controller.feedback", c.controller.feedback);
+      pi.output_index = output;
+      return std::make_unique<PiController>(pi);
+    }
+    case ControllerKind::kPvp: {
+      const int output = controller_output(c, layout);
+      PvpConfig pvp = c.controller.pvp;
+      pvp.angle_input = required_input(c, layout, "controller.feedback", c.controller.feedback);
+      pvp.pressure_input = required_input(c, layout, "controller.pressure", c.controller.pressure);
+      pvp.output_index = output;
+      return std::make_unique<PvpController>(pvp);
+    }
+    case ControllerKind::kPassive:
+    case ControllerKind::kFuzzy:
+    case ControllerKind::kSkyhook:
+    case ControllerKind::kLqr: return make_suspension_controller(c, layout);
   }
-  PvpConfig pvp = c.controller.pvp;
-  pvp.angle_input = required_input(c, layout, "controller.feedback", c.controller.feedback);
-  pvp.pressure_input = required_input(c, layout, "controller.pressure", c.controller.pressure);
-  pvp.output_index = output;
-  return std::make_unique<PvpController>(pvp);
+  throw std::logic_error("make_controller: controller kind out of range");
 }
 
 std::unique_ptr<FilteredProfile> make_profile(const RigConfig& c, double& duration) {
   const auto& p = c.profile;
   std::unique_ptr<SetpointProfile> raw;
   const LeadIn lead{p.start, p.ramp_target, p.hold_s, p.ramp_rate};
-  if (p.type == "hold") {
-    raw = std::make_unique<HoldProfile>(p.value, p.duration_s);
-  } else if (p.type == "ramp_steps") {
-    raw = std::make_unique<RampStepsProfile>(lead, p.steps, p.step_hold_s);
-  } else if (p.type == "sine") {
-    raw = std::make_unique<SineProfile>(lead, p.amplitude, p.frequency_hz, p.cycles);
-  } else {
-    try {
-      raw = std::make_unique<TableProfile>(TableProfile::from_csv(p.csv_file, p.csv_column));
-    } catch (const std::exception& e) {
-      config_fail(c, "profile.file", e.what());
-    }
+  switch (p.type) {
+    case ProfileKind::kHold:
+      raw = std::make_unique<HoldProfile>(p.value, p.duration_s);
+      break;
+    case ProfileKind::kRampSteps:
+      raw = std::make_unique<RampStepsProfile>(lead, p.steps, p.step_hold_s);
+      break;
+    case ProfileKind::kSine:
+      raw = std::make_unique<SineProfile>(lead, p.amplitude, p.frequency_hz, p.cycles);
+      break;
+    case ProfileKind::kCsv:
+      try {
+        raw = std::make_unique<TableProfile>(TableProfile::from_csv(p.csv_file, p.csv_column));
+      } catch (const std::exception& e) {
+        config_fail(c, "profile.file", e.what());
+      }
+      break;
   }
   duration = raw->duration();
   return std::make_unique<FilteredProfile>(std::move(raw), p.filter_tau_s, c.loop.period_s);
-}
-
-DetectorKind detector_kind(const std::string& type) {
-  if (type == "range") return DetectorKind::kRange;
-  if (type == "rate") return DetectorKind::kRate;
-  if (type == "tracking_error") return DetectorKind::kTrackingError;
-  if (type == "valve_saturation") return DetectorKind::kValveSaturation;
-  if (type == "sample_age") return DetectorKind::kSampleAge;
-  if (type == "overruns") return DetectorKind::kOverruns;
-  if (type == "open_circuit") return DetectorKind::kOpenCircuit;
-  return DetectorKind::kStuck;
 }
 
 // Order matters: the first of the most severe trips names why a run ended.
@@ -248,7 +277,7 @@ LimitDetectors make_detectors(const RigConfig& c, const ChannelLayout& layout, i
     const std::string key = "safety.detectors." + d.name;
     DetectorSpec s;
     s.name = key;
-    s.kind = detector_kind(d.type);
+    s.kind = d.type;
     s.min = d.min;
     s.max = d.max;
     s.duration_s = d.duration_s;
@@ -258,14 +287,27 @@ LimitDetectors make_detectors(const RigConfig& c, const ChannelLayout& layout, i
     s.window_s = d.window_s;
     s.action = d.action;
     s.latch = d.latch;
-    if (s.kind == DetectorKind::kTrackingError) {
-      s.channel = d.channel.empty() ? feedback : required_input(c, layout, key + ".channel", d.channel);
-    } else if (s.kind == DetectorKind::kValveSaturation) {
-      s.channel = required_output(c, layout, key + ".output", d.output);
-    } else if (s.kind != DetectorKind::kSampleAge && s.kind != DetectorKind::kOverruns) {
-      s.channel = required_input(c, layout, key + ".channel", d.channel);
+    switch (s.kind) {
+      case DetectorKind::kTrackingError:  // default: the controller's feedback
+        s.channel = d.channel.empty() ? feedback : required_input(c, layout, key + ".channel", d.channel);
+        break;
+      case DetectorKind::kValveSaturation:
+        s.channel = required_output(c, layout, key + ".output", d.output);
+        break;
+      case DetectorKind::kStuck:  // the input that should move while its output commands it
+        s.channel = required_input(c, layout, key + ".channel", d.channel);
+        s.command_output = required_output(c, layout, key + ".output", d.output);
+        break;
+      case DetectorKind::kInvalid:  // (built above for every input, never configured)
+      case DetectorKind::kRange:
+      case DetectorKind::kRate:
+      case DetectorKind::kOpenCircuit:
+        s.channel = required_input(c, layout, key + ".channel", d.channel);
+        break;
+      case DetectorKind::kSampleAge:  // the sample's time stamp
+      case DetectorKind::kOverruns:   // the loop's count
+        break;
     }
-    if (s.kind == DetectorKind::kStuck) s.command_output = required_output(c, layout, key + ".output", d.output);
     specs.push_back(s);
   }
   try {
@@ -292,10 +334,12 @@ SafetyOptions make_safety(const RigConfig& c, int feedback) {
 
 }  // namespace
 
-std::string setpoint_name_for(const std::string& rig) {
-  if (rig == "quarter_car") return "x_ref";
-  if (rig == "pneumatic_rotary") return "theta_d";
-  if (rig == "half_car") return "z_s_ref";  // body heave demand (0: hold the body at rest)
+std::string setpoint_name_for(RigKind rig) {
+  switch (rig) {
+    case RigKind::kQuarterCar: return "x_ref";
+    case RigKind::kPneumaticRotary: return "theta_d";
+    case RigKind::kHalfCar: return "z_s_ref";  // body heave demand (0: hold the body at rest)
+  }
   return "setpoint";
 }
 

@@ -37,6 +37,6 @@ AssembledRig assemble_rig(const RigConfig& config);
 std::unique_ptr<SimulatedPlant> make_plant(const RigConfig& config);
 
 // Run-file name of the demand for a rig kind ("x_ref" for quarter_car).
-std::string setpoint_name_for(const std::string& rig);
+std::string setpoint_name_for(RigKind rig);
 
 }  // namespace rigctl

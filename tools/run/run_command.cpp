@@ -63,7 +63,7 @@ RunReport run_rig(const RunOptions& options, const std::atomic<bool>& stop, std:
 RunReport run_rig(const RigConfig& config, const RunOptions& options, const std::atomic<bool>& stop, std::ostream& out) {
   AssembledRig rig = assemble_rig(config);
   if (options.fast && !rig.driver->simulated()) {
-    throw std::runtime_error("--fast needs a simulated driver: '" + config.driver + "' runs real hardware in real time");
+    throw std::runtime_error("--fast needs a simulated driver: '" + std::string(to_string(config.driver)) + "' runs real hardware in real time");
   }
   // Injected faults (drivers/sim/sim_faults.hpp): the config's `faults:`, then --fault.
   std::vector<FaultSpec> faults = config.faults;
@@ -94,11 +94,11 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
   loop_options.timing_every_ticks = std::max<int64_t>(1, std::llround(config.loop.timing_publish_s / config.loop.period_s));
 
   RunReport report;
-  report.log_path = options.log_path.empty() ? default_log_path(config.telemetry.log_dir, config.rig) : options.log_path;
+  report.log_path = options.log_path.empty() ? default_log_path(config.telemetry.log_dir, std::string(to_string(config.rig))) : options.log_path;
   report.csv_path = options.csv_path;
 
   TelemetryMeta meta;
-  meta.rig = config.rig;
+  meta.rig = to_string(config.rig);
   meta.layout = rig.driver->layout();
   meta.setpoint_name = rig.setpoint_name;
   meta.controller_name = rig.controller->name();
@@ -118,11 +118,11 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
                                   : static_cast<std::size_t>(10.0 / config.loop.period_s);
   TelemetryPublisher publisher(meta, url, report.log_path, queue_capacity);
   Driver* driver = rig.driver.get();
-  publisher.set_diagnostics_source([driver] { return driver->diagnostics(); }, config.driver);
+  publisher.set_diagnostics_source([driver] { return driver->diagnostics(); }, std::string(to_string(config.driver)));
 
   // The event log: every state change, trip and command, fsync'd per line.
   report.events_path = options.events_path.empty() ? report.log_path + ".events" : options.events_path;
-  EventLog events(report.events_path, EventLogMeta{config.rig, rig.driver->layout(), meta.start_utime, meta.queue_policy});
+  EventLog events(report.events_path, EventLogMeta{meta.rig, rig.driver->layout(), meta.start_utime, meta.queue_policy});
   events.set_failure_handler([&publisher](const std::string& text) {
     spdlog::error("{}", text);
     publisher.report_event("log_write_failed", text);

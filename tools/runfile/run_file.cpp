@@ -79,26 +79,34 @@ std::optional<double> RunFile::meta_number(const std::string& key) const {
   return x;
 }
 
-RunFileOptions run_file_columns(const std::string& rig) {
+RunFileRig run_file_rig_from_string(const std::string& name) {
+  if (const auto rig = kind_from_string<RunFileRig>(name)) return *rig;
+  throw RunFileError(unknown_kind_message<RunFileRig>(name));
+}
+
+RunFileOptions run_file_columns(RunFileRig rig) {
   RunFileOptions o;
-  if (rig == "quarter_car") {
-    o.required = {"x_ref", "u", "x_r", "x_w", "x_b"};
-    o.optional = {"v_w", "v_b", "p1", "p2", "f_t"};
-  } else if (rig == "pneumatic_rotary") {
-    o.required = {"theta_d", "u", "theta", "dp"};
-    o.optional = {"omega"};
-  } else if (rig == "half_car") {
-    o.required = {"z_r1", "z_r2", "z_s", "phi", "z_u1", "z_u2"};
-    o.optional = {"f_1", "f_2"};
-  } else if (rig == "linear_axis") {
-    o.required = {"u", "x"};
-    o.optional = {"x_ref", "f_ext"};
-  } else if (rig == "damper") {
-    o.required = {"x", "f"};
-    o.optional = {"v", "u"};
-  } else {
-    throw RunFileError("unknown rig kind '" + rig +
-                       "' (known: quarter_car, pneumatic_rotary, half_car, linear_axis, damper)");
+  switch (rig) {
+    case RunFileRig::kQuarterCar:
+      o.required = {"x_ref", "u", "x_r", "x_w", "x_b"};
+      o.optional = {"v_w", "v_b", "p1", "p2", "f_t"};
+      break;
+    case RunFileRig::kPneumaticRotary:
+      o.required = {"theta_d", "u", "theta", "dp"};
+      o.optional = {"omega"};
+      break;
+    case RunFileRig::kHalfCar:
+      o.required = {"z_r1", "z_r2", "z_s", "phi", "z_u1", "z_u2"};
+      o.optional = {"f_1", "f_2"};
+      break;
+    case RunFileRig::kLinearAxis:
+      o.required = {"u", "x"};
+      o.optional = {"x_ref", "f_ext"};
+      break;
+    case RunFileRig::kDamper:
+      o.required = {"x", "f"};
+      o.optional = {"v", "u"};
+      break;
   }
   return o;
 }

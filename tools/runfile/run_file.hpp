@@ -27,6 +27,8 @@
 #include <utility>
 #include <vector>
 
+#include "tools/runfile/run_file_rig.hpp"
+
 namespace rigctl {
 
 class RunFileError : public std::runtime_error {
@@ -58,8 +60,12 @@ struct RunFile {
   std::size_t size() const { return t.size(); }
 };
 
-// Columns the contract lists for a rig kind; throws RunFileError for an unknown kind.
-RunFileOptions run_file_columns(const std::string& rig);
+// A rig kind by its name (`--rig`, `# rig:`); throws RunFileError naming
+// the known kinds for another name: bad input like the file itself.
+RunFileRig run_file_rig_from_string(const std::string& name);
+
+// Columns the contract lists for a rig kind.
+RunFileOptions run_file_columns(RunFileRig rig);
 
 RunFile parse_run_file(std::istream& in, const std::string& name, const RunFileOptions& options);
 RunFile read_run_file(const std::string& path, const RunFileOptions& options);

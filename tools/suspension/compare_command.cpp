@@ -275,11 +275,14 @@ double half_car_disturbance_start(const HalfCarParams& p) {
   return 0.0;
 }
 
-SuspensionRecording run_half_car(const RigConfig& config, const std::string& controller_type, double duration_s,
+SuspensionRecording run_half_car(const RigConfig& config, ControllerKind controller_type, double duration_s,
                                  bool keep_rows) {
-  if (config.rig != "half_car") throw std::runtime_error("this command is for the half_car rig, not " + config.rig);
-  if (config.driver != "sim") {
-    throw std::runtime_error("this command runs the simulated rig: '" + config.driver + "' would drive hardware");
+  if (config.rig != RigKind::kHalfCar) {
+    throw std::runtime_error("this command is for the half_car rig, not " + std::string(to_string(config.rig)));
+  }
+  if (!is_simulated(config.driver)) {
+    throw std::runtime_error("this command runs the simulated rig: '" + std::string(to_string(config.driver)) +
+                             "' would drive hardware");
   }
   RigConfig c = config;
   c.controller.type = controller_type;
@@ -288,7 +291,7 @@ SuspensionRecording run_half_car(const RigConfig& config, const std::string& con
   if (sim == nullptr) throw std::runtime_error("the half car comparison needs the simulated driver");
 
   SuspensionRecording rec;
-  rec.controller = controller_type;
+  rec.controller = to_string(controller_type);
   for (const auto& s : rig.driver->layout().inputs) rec.signal_names.push_back(s.name);
   for (const auto& s : rig.driver->layout().outputs) rec.output_names.push_back(s.name);
   rec.setpoint_name = rig.setpoint_name;
@@ -341,10 +344,11 @@ void write_recording_csv(const SuspensionRecording& rec, const std::string& path
 
 CompareResult run_compare(const CompareOptions& options, std::ostream& out) {
   const RigConfig config = load_rig_config(options.config_path, options.case_name);
-  if (config.rig != "half_car") {
-    throw ConfigError(options.config_path + ": rig: `rigctl compare` is for the half_car rig, this config is " + config.rig);
+  if (config.rig != RigKind::kHalfCar) {
+    throw ConfigError(options.config_path + ": rig: `rigctl compare` is for the half_car rig, this config is " +
+                      std::string(to_string(config.rig)));
   }
-  const double duration = config.profile.type == "hold" ? config.profile.duration_s : 0.0;
+  const double duration = config.profile.type == ProfileKind::kHold ? config.profile.duration_s : 0.0;
   if (!(duration > 0.0)) {
     throw ConfigError(options.config_path + ": profile.type: `rigctl compare` needs a `hold` profile (the body held at rest)");
   }
@@ -366,10 +370,10 @@ CompareResult run_compare(const CompareOptions& options, std::ostream& out) {
   out.flush();
 
   const auto& types = suspension_controller_types();
-  for (const auto& type : types) {
-    result.runs.push_back(run_half_car(config, type, duration));
+  for (const ControllerKind controller : suspension_controllers()) {
+    result.runs.push_back(run_half_car(config, controller, duration));
     const auto& rec = result.runs.back();
-    out << "  " << std::left << std::setw(8) << type << std::right << " " << rec.loop.ticks << " ticks, "
+    out << "  " << std::left << std::setw(8) << controller << std::right << " " << rec.loop.ticks << " ticks, "
         << to_string(rec.loop.final_state) << "\n";
     out.flush();
   }

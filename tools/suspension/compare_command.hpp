@@ -43,7 +43,7 @@ double half_car_disturbance_start(const HalfCarParams& p);
 // duration_s of simulated time. keep_rows = false keeps only `run` (the
 // optimiser's evaluations). Throws ConfigError for a config that cannot be
 // assembled, std::runtime_error for a rig that is not a simulated half car.
-SuspensionRecording run_half_car(const RigConfig& config, const std::string& controller_type, double duration_s,
+SuspensionRecording run_half_car(const RigConfig& config, ControllerKind controller_type, double duration_s,
                                  bool keep_rows = true);
 
 // Writes a recording as a run file (docs/run-files.md): metadata

@@ -229,8 +229,9 @@ void write_evaluation(std::ostream& js, const char* name, const DesignEvaluation
 
 OptimizeResult run_optimize(const OptimizeOptions& options, std::ostream& out, std::ostream& progress) {
   const RigConfig config = load_rig_config(options.config_path, options.case_name);
-  if (config.rig != "half_car") {
-    throw ConfigError(options.config_path + ": rig: `rigctl optimize` is for the half_car rig, this config is " + config.rig);
+  if (config.rig != RigKind::kHalfCar) {
+    throw ConfigError(options.config_path + ": rig: `rigctl optimize` is for the half_car rig, this config is " +
+                      std::string(to_string(config.rig)));
   }
   OptimizeResult result;
   result.settings = config.suspension_optimize;
@@ -334,7 +335,7 @@ OptimizeResult run_optimize(const OptimizeOptions& options, std::ostream& out, s
   }
   js << "{\n  \"rig\": \"half_car\",\n  \"config\": " << json_string(options.config_path)
      << ",\n  \"case\": " << json_string(options.case_name) << ",\n  \"algorithm\": " << json_string(s.algorithm)
-     << ",\n  \"controller\": " << json_string(s.controller) << ",\n  \"seed\": " << s.seed
+     << ",\n  \"controller\": " << json_string(std::string(to_string(s.controller))) << ",\n  \"seed\": " << s.seed
      << ",\n  \"evaluations\": " << result.evaluations << ",\n  \"max_evaluations\": " << s.evaluations
      << ",\n  \"nlopt_result\": " << json_string(result.nlopt_result)
      << ",\n  \"elapsed_s\": " << json_number(result.elapsed_s) << ",\n  \"duration_s\": " << json_number(s.duration_s)

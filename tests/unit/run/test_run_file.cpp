@@ -28,7 +28,7 @@ std::string error_of(const std::string& text, RunFileOptions o = {}) {
   return "";
 }
 
-RunFileOptions damper() { return run_file_columns("damper"); }
+RunFileOptions damper() { return run_file_columns(RunFileRig::kDamper); }
 
 TEST(RunFile, MetadataHeaderAndColumns) {
   const auto rf = parse("# rig: damper\n# sample_rate_hz: 1000\n# note: a: b\nt,x,f,extra\n" + [] {
@@ -144,8 +144,13 @@ TEST(RunFile, TooFewRowsAndNoHeader) {
 
 TEST(RunFile, DuplicateColumnAndUnknownRig) {
   EXPECT_NE(error_of("t,x,x,f\n" + rows(20), damper()).find("duplicate column 'x'"), std::string::npos);
-  EXPECT_THROW(run_file_columns("bicycle"), RunFileError);
-  EXPECT_EQ(run_file_columns("quarter_car").required.size(), 5u);
+  try {
+    run_file_rig_from_string("bicycle");
+    FAIL();
+  } catch (const RunFileError& e) {
+    EXPECT_STREQ(e.what(), "unknown rig kind 'bicycle' (known: quarter_car, pneumatic_rotary, half_car, linear_axis, damper)");
+  }
+  EXPECT_EQ(run_file_columns(run_file_rig_from_string("quarter_car")).required.size(), 5u);
 }
 
 TEST(RunFile, BadMetadataNumberNamed) {

@@ -118,7 +118,7 @@ class HalfCarDiagModel : public RigModel {
     }
   }
 
-  std::string rig() const override { return "half_car"; }
+  RunFileRig rig() const override { return RunFileRig::kHalfCar; }
   const std::vector<Output>& outputs() const override { return outputs_; }
   const std::vector<double>& time() const override { return t_; }
   std::vector<ParamSpec> baseline() const override {
@@ -252,9 +252,7 @@ class HalfCarDiagModel : public RigModel {
     std::string file = path;
     if (file.empty() && std::filesystem::exists("config/half_car.yaml")) file = "config/half_car.yaml";
     if (file.empty()) return HalfCarParams{};
-    const auto cfg = load_rig_config(file);
-    if (cfg.rig != "half_car") throw RunFileError("--config is a '" + cfg.rig + "' config, not half_car");
-    return cfg.half_car;
+    return load_replay_config(file, RigKind::kHalfCar).half_car;
   }
   // Centrifugal roll moment of the config's curve (roll plane): a known input.
   double roll_moment(double t) const {

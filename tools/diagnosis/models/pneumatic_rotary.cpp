@@ -103,12 +103,8 @@ class PneumaticRotaryModel : public RigModel {
     std::string path = o.config_path;
     if (path.empty() && std::filesystem::exists("config/pneumatic_rotary.yaml")) path = "config/pneumatic_rotary.yaml";
     if (!path.empty()) {
-      const auto cfg = load_rig_config(path);
-      if (cfg.rig != "pneumatic_rotary")
-        throw RunFileError("--config is a '" + cfg.rig + "' config, not pneumatic_rotary");
-      if (cfg.controller.type != "pvp")
-        throw RunFileError("pneumatic_rotary: the replay needs the pvp controller, the config has '" +
-                           cfg.controller.type + "'");
+      // The loader gives a pneumatic_rotary config its own controller, pvp (rig_of).
+      const auto cfg = load_replay_config(path, RigKind::kPneumaticRotary);
       p_ = cfg.pneumatic_rotary;
       pvp_ = cfg.controller.pvp;
       source = path;
@@ -140,7 +136,7 @@ class PneumaticRotaryModel : public RigModel {
     travel_ = travel_since_reversal(outputs_[0].measured);
   }
 
-  std::string rig() const override { return "pneumatic_rotary"; }
+  RunFileRig rig() const override { return RunFileRig::kPneumaticRotary; }
   const std::vector<Output>& outputs() const override { return outputs_; }
   const std::vector<double>& time() const override { return t_; }
 

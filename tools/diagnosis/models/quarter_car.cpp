@@ -96,8 +96,7 @@ class QuarterCarModel : public RigModel {
  public:
   QuarterCarModel(const RunFile& run, const RigModelOptions& o) : t_(run.t), dt_(run.dt) {
     if (!o.config_path.empty()) {
-      const auto cfg = load_rig_config(o.config_path);
-      if (cfg.rig != "quarter_car") throw RunFileError("--config is a '" + cfg.rig + "' config, not quarter_car");
+      const auto cfg = load_replay_config(o.config_path, RigKind::kQuarterCar);
       p_ = cfg.quarter_car;
       pi_ = cfg.controller.pi;
     }
@@ -117,7 +116,7 @@ class QuarterCarModel : public RigModel {
       outputs_.push_back({"p2", run.col("p2")});
     }
   }
-  std::string rig() const override { return "quarter_car"; }
+  RunFileRig rig() const override { return RunFileRig::kQuarterCar; }
   const std::vector<Output>& outputs() const override { return outputs_; }
   const std::vector<double>& time() const override { return t_; }
   std::vector<ParamSpec> baseline() const override {
