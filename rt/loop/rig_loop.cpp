@@ -1,7 +1,5 @@
 #include "rt/loop/rig_loop.hpp"
 
-#include <limits>
-
 namespace rigctl {
 
 namespace {
@@ -25,24 +23,7 @@ RigState coarse_state(SafetyState s, bool ever_ran) noexcept {
 constexpr OperatorCommand kStopCommand{OperatorCommandKind::kStop, 0.0, 0};
 constexpr OperatorCommand kHydraulicsOffCommand{OperatorCommandKind::kHydraulicsOff, 0.0, 0};
 
-// The loop as it was before the state machine (tests, benchmarks, the
-// hidden-effect generator): the profile from tick 0 as configured and the
-// run ending at max_ticks without a ramp. Infinite rates make the demand
-// shaper pass everything through; `rigctl run` configures real ones.
-SafetyOptions unshaped() {
-  SafetyOptions s;
-  s.machine.hold_deceleration = std::numeric_limits<double>::infinity();
-  s.machine.setpoint_rate = std::numeric_limits<double>::infinity();
-  return s;
-}
-
 }  // namespace
-
-RigLoop::RigLoop(Driver& driver, Controller& controller, FilteredProfile& profile, const LimitCheck& limits,
-                 TelemetrySink& telemetry, LoopClock& clock, const LoopOptions& options)
-    : RigLoop(driver, controller, profile,
-              LimitDetectors::from_limit_check(limits, static_cast<double>(options.period_ns) * 1e-9), telemetry,
-              clock, options, unshaped()) {}
 
 RigLoop::RigLoop(Driver& driver, Controller& controller, FilteredProfile& profile, LimitDetectors detectors,
                  TelemetrySink& telemetry, LoopClock& clock, const LoopOptions& options, const SafetyOptions& safety)

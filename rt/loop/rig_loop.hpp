@@ -31,7 +31,6 @@
 #include "rt/loop/loop_events.hpp"
 #include "rt/loop/run_state.hpp"
 #include "rt/loop_clock.hpp"
-#include "rt/safety/limit_check.hpp"
 #include "rt/safety/limit_detectors.hpp"
 #include "rt/safety/operator_command.hpp"
 #include "rt/safety/rig_state_machine.hpp"
@@ -73,10 +72,6 @@ struct LoopResult {
 
 class RigLoop {
  public:
-  // Today's interface: the LimitCheck as interlock detectors, the automatic
-  // sequence, no operator.
-  RigLoop(Driver& driver, Controller& controller, FilteredProfile& profile, const LimitCheck& limits,
-          TelemetrySink& telemetry, LoopClock& clock, const LoopOptions& options);
   // The rig as `rigctl run` assembles it (tools/run/rig_assembly.hpp): its
   // limit detectors and the state machine's settings.
   RigLoop(Driver& driver, Controller& controller, FilteredProfile& profile, LimitDetectors detectors,
