@@ -1,7 +1,5 @@
 #include "rt/loop/rig_loop.hpp"
 
-#include <limits>
-
 namespace rigctl {
 
 namespace {
@@ -11,34 +9,21 @@ StateMachineConfig with_period(StateMachineConfig c, int64_t period_ns) {
   return c;
 }
 
-// What `rigctl run` does without an operator, each command as soon as the
-// state machine allows it.
-constexpr OperatorCommandKind kAutoSequence[] = {OperatorCommandKind::kReset, OperatorCommandKind::kHydraulicsLow,
-                                                 OperatorCommandKind::kHydraulicsHigh, OperatorCommandKind::kArm,
-                                                 OperatorCommandKind::kStart};
-constexpr std::size_t kAutoSteps = sizeof kAutoSequence / sizeof kAutoSequence[0];
-
-// Operator commands handled per tick at most: a flood cannot stretch a tick.
-constexpr int kMaxCommandsPerTick = 8;
-
-// The loop as it was before the state machine (tests, benchmarks, the
-// hidden-effect generator): the profile from tick 0 as configured and the
-// run ending at max_ticks without a ramp. Infinite rates make the demand
-// shaper pass everything through; `rigctl run` configures real ones.
-SafetyOptions unshaped() {
-  SafetyOptions s;
-  s.machine.hold_deceleration = std::numeric_limits<double>::infinity();
-  s.machine.setpoint_rate = std::numeric_limits<double>::infinity();
-  return s;
+// The record's coarse state: before the rig first ran it is "starting".
+RigState coarse_state(SafetyState s, bool ever_ran) noexcept {
+  switch (s) {
+    case SafetyState::kRunning:
+    case SafetyState::kHolding: return RigState::kRunning;
+    case SafetyState::kStopping: return RigState::kStopping;
+    case SafetyState::kFaulted: return ever_ran ? RigState::kFaulted : RigState::kStarting;
+    default: return ever_ran ? RigState::kStopped : RigState::kStarting;
+  }
 }
 
-}  // namespace
+constexpr OperatorCommand kStopCommand{OperatorCommandKind::kStop, 0.0, 0};
+constexpr OperatorCommand kHydraulicsOffCommand{OperatorCommandKind::kHydraulicsOff, 0.0, 0};
 
-RigLoop::RigLoop(Driver& driver, Controller& controller, FilteredProfile& profile, const LimitCheck& limits,
-                 TelemetrySink& telemetry, LoopClock& clock, const LoopOptions& options)
-    : RigLoop(driver, controller, profile,
-              LimitDetectors::from_limit_check(limits, static_cast<double>(options.period_ns) * 1e-9), telemetry,
-              clock, options, unshaped()) {}
+}  // namespace
 
 RigLoop::RigLoop(Driver& driver, Controller& controller, FilteredProfile& profile, LimitDetectors detectors,
                  TelemetrySink& telemetry, LoopClock& clock, const LoopOptions& options, const SafetyOptions& safety)
@@ -46,263 +31,23 @@ RigLoop::RigLoop(Driver& driver, Controller& controller, FilteredProfile& profil
       telemetry_(telemetry), clock_(clock), options_(options), safety_(safety),
       machine_(with_period(safety.machine, options.period_ns)), timing_(options.period_ns, options.overrun_policy) {}
 
-void RigLoop::emit(TelemetryRecord& record, bool with_timing) noexcept {
-  record.has_timing = with_timing;
-  if (with_timing) record.timing = timing_.summary();
-  if (!telemetry_.push(record)) ++dropped_;
-}
-
-void RigLoop::log_event(const EventRecord& e) noexcept {
-  if (events_ != nullptr && !events_->push(e)) ++dropped_events_;
-}
-
-void RigLoop::log_changes(int64_t tick, int64_t t_ns) noexcept {
-  for (; changes_logged_ < machine_.change_count(); ++changes_logged_) {
-    const StateChange& c = machine_.changes()[changes_logged_];
-    EventRecord e;
-    e.tick = tick;
-    e.t_ns = t_ns;
-    e.state = c.to;
-    e.from = c.from;
-    e.cause = c.cause;
-    e.event = Event{EventCode::kStateChanged, -1, static_cast<double>(c.from), static_cast<uint8_t>(c.to), 0};
-    log_event(e);
-  }
-}
-
-RigState RigLoop::coarse_state() const noexcept {
-  switch (machine_.state()) {
-    case SafetyState::kRunning:
-    case SafetyState::kHolding: return RigState::kRunning;
-    case SafetyState::kStopping: return RigState::kStopping;
-    case SafetyState::kFaulted: return ever_ran_ ? RigState::kFaulted : RigState::kStarting;
-    default: return ever_ran_ ? RigState::kStopped : RigState::kStarting;
-  }
-}
-
 LoopResult RigLoop::run(const std::atomic<bool>& stop_requested) {
-  LoopResult result;
-  TelemetryRecord record;
-  controller_.reset();
-  profile_.reset();
-  machine_.power_on();
-  ever_ran_ = false;
-  frozen_ns_ = 0;
-  const int feedback = safety_.feedback_input >= 0 ? safety_.feedback_input
-                                                   : (options_.start_from_input >= 0 ? options_.start_from_input : 0);
-  std::size_t next_auto = safety_.auto_sequence ? 0 : kAutoSteps;
-
-  int64_t deadline = clock_.now_ns();
-  int64_t tick = 0;
-  Event end_event{EventCode::kProfileFinished, -1, 0.0};
-  Event worst_trip{};  // the most severe trip of the run (hold or worse makes the run count as faulted)
-  bool ended_by_fault = false;
-  bool stop_seen = false, stop_applied = false, end_stop_applied = false;
-  // Operator mode ends when the operator has stopped the rig and then turned
-  // the hydraulics off: the test is over and the rig is safe.
-  bool operator_stopped = false;
-  bool valve_was_enabled = false;
-  double last_demand = 0.0;
-  Command last_command{};
-  Event tick_event{};
-
-  // One command through the state machine, with its consequences for the
-  // detectors, the controller and the profile, and its event.
-  auto command = [&](OperatorCommand c, EventSource source, int64_t t_ns, bool log_refusal) {
-    const CommandResult r = machine_.apply(c);
-    if (r.accepted) {
-      if (r.reset_latches) {
-        detectors_.clear_latches();
-        worst_trip = Event{};
-      }
-      if (c.kind == OperatorCommandKind::kArm) controller_.reset();  // take over the valve with a fresh integrator
-      if (source == EventSource::kOperator && c.kind == OperatorCommandKind::kStop) operator_stopped = true;
-      if (c.kind == OperatorCommandKind::kStart) operator_stopped = false;  // a new test after a re-arm
-      if (c.kind == OperatorCommandKind::kStart) {
-        // The profile from its beginning: its clock restarts at the run's first sample time.
-        profile_.reset();
-        frozen_ns_ = t_ns - first_t_ns_;
-        if (options_.start_from_input >= 0) {
-          profile_.start_from(record.sample.value[static_cast<std::size_t>(options_.start_from_input)]);
-        }
-      }
-    }
-    if (r.accepted || log_refusal) {
-      EventRecord e;
-      e.tick = tick;
-      e.t_ns = t_ns;
-      e.state = machine_.state();
-      e.source = source;
-      e.sequence = c.sequence;
-      e.event = r.accepted ? Event{EventCode::kCommandAccepted, -1, c.value, static_cast<uint8_t>(c.kind), 0}
-                           : Event{EventCode::kCommandRejected, static_cast<int16_t>(c.kind), c.value,
-                                   static_cast<uint8_t>(r.reason), 0};
-      log_event(e);
-      if (source == EventSource::kOperator || source == EventSource::kSignal) tick_event = e.event;
-    }
-    log_changes(tick, t_ns);  // the state change right after the command that caused it
-    return r;
-  };
-
+  RunState run;
+  begin_run(run);
   try {
-    for (;; ++tick) {
-      clock_.sleep_until(deadline);
-      const int64_t start = clock_.now_ns();
-      timing_.on_wake(deadline, start);
-
-      if (stop_requested.load(std::memory_order_relaxed) && !stop_seen) {
-        stop_seen = true;
-        end_event = Event{EventCode::kStopRequested, -1, 0.0};
-        if (!machine_.valve_enabled()) break;  // nothing to ramp: the rig is already safe
-      }
-
-      record = TelemetryRecord{};
-      record.tick = tick;
-      tick_event = Event{};
-      if (!driver_.read(record.sample)) {
-        end_event = Event{EventCode::kDriverReadFailed, -1, 0.0};
-        ended_by_fault = true;
+    for (;; ++run.tick) {
+      wait(run);
+      if (notice_stop_request(stop_requested, run) == Step::kEndRun) break;
+      if (read(run) == Step::kEndRun) break;
+      if (check(run) == Step::kEndRun) break;
+      take_commands(run);
+      demand(run);
+      control_and_write(run);
+      hand_off(run);
+      if (decide_end(run) == Step::kEndRun) {
+        ++run.tick;  // this tick was handed off: it counts
         break;
       }
-      const int64_t t_ns = record.sample.t_ns;
-      if (tick == 0) {
-        first_t_ns_ = prev_t_ns_ = t_ns;
-        EventRecord e;
-        e.t_ns = t_ns;
-        e.state = machine_.state();
-        e.event = Event{EventCode::kRunStarted, -1, 0.0};
-        log_event(e);
-      }
-
-      // Limit detectors, on what the previous tick commanded.
-      DetectorInputs din;
-      din.sample = &record.sample;
-      din.now_ns = start;
-      din.demand = last_demand;
-      din.command = &last_command;
-      din.valve_driven = machine_.valve_enabled();
-      din.overruns = timing_.overruns();
-      const DetectorResult& trips = detectors_.check(din);
-      const std::size_t kept = trips.new_count < kMaxTripsPerTick ? trips.new_count : kMaxTripsPerTick;
-      for (std::size_t i = 0; i < kept; ++i) {
-        const Event ev = trips.new_trips[i].event();
-        if (ev.action > worst_trip.action) worst_trip = ev;
-        EventRecord e;
-        e.tick = tick;
-        e.t_ns = t_ns;
-        e.state = machine_.state();
-        e.event = ev;
-        log_event(e);
-      }
-
-      MachineInputs in;
-      in.limit_action = trips.action;
-      in.faults_present = trips.faults_present;
-      in.feedback_valid = !trips.feedback_invalid;
-      in.feedback = record.sample.value[static_cast<std::size_t>(feedback)];
-      changes_logged_ = 0;
-      const SafetyState before = machine_.state();
-      machine_.begin_tick(in, worst_trip.code);
-      if (machine_.state() == SafetyState::kFaulted && before != SafetyState::kFaulted) {
-        driver_.make_safe();  // a fault puts the valve to its safe command at once
-        valve_was_enabled = false;
-      }
-      // Without an operator an interlock ends the run on this tick, before
-      // anything is written (today's behaviour of `rigctl run`).
-      if (safety_.auto_sequence && trips.action == LimitAction::kInterlock) {
-        log_changes(tick, t_ns);
-        end_event = worst_trip.code != EventCode::kNone ? worst_trip : trips.worst_new.event();
-        ended_by_fault = true;
-        break;
-      }
-      if (safety_.auto_sequence && machine_.state() == SafetyState::kFaulted && before != SafetyState::kFaulted) {
-        log_changes(tick, t_ns);
-        const StateChange& last = machine_.changes()[machine_.change_count() - 1];
-        end_event = Event{last.cause, -1, 0.0};
-        ended_by_fault = true;
-        break;
-      }
-
-      // Commands: a stop request, the operator's, the automatic sequence.
-      if (stop_seen && !stop_applied) {
-        stop_applied = true;
-        command(OperatorCommand{OperatorCommandKind::kStop, 0.0, 0}, EventSource::kSignal, t_ns, true);
-      }
-      if (commands_ != nullptr) {
-        OperatorCommand c;
-        for (int n = 0; n < kMaxCommandsPerTick && commands_->try_pop(c); ++n) command(c, EventSource::kOperator, t_ns, true);
-      }
-      while (next_auto < kAutoSteps && !stop_seen && !end_stop_applied) {
-        const OperatorCommand c{kAutoSequence[next_auto], 0.0, 0};
-        if (!command(c, EventSource::kAutomatic, t_ns, false).accepted) break;  // not yet: retried next tick
-        ++next_auto;
-      }
-      log_changes(tick, t_ns);
-
-      // Demand and control.
-      const bool enabled = machine_.valve_enabled();
-      if (!enabled && valve_was_enabled) driver_.make_safe();
-      if (tick > 0 && !machine_.profile_clock_running()) frozen_ns_ += t_ns - prev_t_ns_;
-      double demand = last_demand;
-      if (enabled) {
-        double profile = 0.0;
-        if (machine_.demand_mode() == DemandMode::kProfile) {
-          const double t_profile = static_cast<double>(t_ns - frozen_ns_) * 1e-9;
-          profile = profile_.next(t_profile);
-          if (!safety_.auto_sequence &&
-              t_profile - static_cast<double>(first_t_ns_) * 1e-9 >= profile_.raw().duration()) {
-            machine_.profile_finished();  // operator mode: hold at the end, wait for the operator
-            log_changes(tick, t_ns);
-          }
-        }
-        demand = machine_.next_demand(profile);
-        controller_.update(demand, record.sample, record.command, record.controller);
-        driver_.write(record.command);
-        if (machine_.state() == SafetyState::kRunning) ever_ran_ = true;
-      } else {
-        // The driver holds its safe command (Driver::make_safe, the one place
-        // it is defined); nothing is written, the record shows no command.
-        record.controller.setpoint = demand;
-        record.controller.measurement = in.feedback;
-      }
-      record.state = coarse_state();
-      record.safety_state = machine_.state();
-      record.valve_enabled = enabled;
-      if (tick == 0) {
-        record.event = Event{EventCode::kRunStarted, -1, 0.0};
-      } else if (trips.new_count > 0) {
-        record.event = trips.worst_new.event();
-      } else {
-        record.event = tick_event;
-      }
-
-      const int64_t end = clock_.now_ns();
-      deadline = timing_.on_done(deadline, start, end);
-      const bool timing_due = options_.timing_every_ticks > 0 && (tick + 1) % options_.timing_every_ticks == 0;
-      emit(record, timing_due);
-      last_demand = demand;
-      last_command = enabled ? record.command : Command{};
-      valve_was_enabled = enabled;
-      prev_t_ns_ = t_ns;
-
-      // The run's length reached: a controlled stop (ramp to hold, disarm).
-      if (tick + 1 >= options_.max_ticks && !end_stop_applied) {
-        end_stop_applied = true;
-        if (machine_.valve_enabled()) command(OperatorCommand{OperatorCommandKind::kStop, 0.0, 0}, EventSource::kAutomatic, t_ns, true);
-      }
-      const bool operator_done = !safety_.auto_sequence && operator_stopped && machine_.state() == SafetyState::kOff;
-      if (operator_done && !stop_seen) end_event = Event{EventCode::kStopRequested, -1, 0.0};
-      const bool finishing = end_stop_applied || stop_seen || operator_done || (safety_.auto_sequence && ever_ran_);
-      if (finishing && !machine_.valve_enabled() && machine_.state() != SafetyState::kStopping) {
-        if (safety_.auto_sequence && machine_.hydraulics() != HydraulicsStage::kOff &&
-            machine_.state() != SafetyState::kFaulted) {
-          command(OperatorCommand{OperatorCommandKind::kHydraulicsOff, 0.0, 0}, EventSource::kAutomatic, t_ns, true);
-        }
-        log_changes(tick, t_ns);
-        ++tick;
-        break;
-      }
-      log_changes(tick, t_ns);
     }
   } catch (...) {
     // Drivers may throw on a broken device; the outputs go safe before the
@@ -311,42 +56,304 @@ LoopResult RigLoop::run(const std::atomic<bool>& stop_requested) {
     throw;
   }
   driver_.make_safe();
+  return finish_run(run);
+}
 
+void RigLoop::begin_run(RunState& run) noexcept {
+  controller_.reset();
+  profile_.reset();
+  machine_.power_on();
+  commands_.restart(safety_.auto_sequence);
+  run.feedback_input = safety_.feedback_input >= 0
+                           ? safety_.feedback_input
+                           : (options_.start_from_input >= 0 ? options_.start_from_input : 0);
+  run.deadline_ns = clock_.now_ns();
+}
+
+// ---- wait
+
+void RigLoop::wait(RunState& run) noexcept {
+  clock_.sleep_until(run.deadline_ns);
+  run.woke_ns = clock_.now_ns();
+  timing_.on_wake(run.deadline_ns, run.woke_ns);
+}
+
+RigLoop::Step RigLoop::notice_stop_request(const std::atomic<bool>& stop_requested, RunState& run) noexcept {
+  if (!stop_requested.load(std::memory_order_relaxed) || run.stop_request_seen) return Step::kCarryOn;
+  run.stop_request_seen = true;
+  run.end_event = Event{EventCode::kStopRequested, -1, 0.0};
+  commands_.request_stop();  // its stop goes in on this tick's commands step
+  return machine_.valve_enabled() ? Step::kCarryOn : Step::kEndRun;  // nothing to ramp: the rig is already safe
+}
+
+// ---- read
+
+RigLoop::Step RigLoop::read(RunState& run) {
+  run.record = TelemetryRecord{};
+  run.record.tick = run.tick;
+  run.command_event = Event{};
+  if (!driver_.read(run.record.sample)) {
+    run.end_event = Event{EventCode::kDriverReadFailed, -1, 0.0};
+    run.ended_by_fault = true;
+    return Step::kEndRun;
+  }
+  if (run.tick == 0) {
+    run.profile_clock.first_t_ns = run.previous_t_ns = run.t_ns();
+    events_.log(loop_event(0, run.t_ns(), machine_.state(), Event{EventCode::kRunStarted, -1, 0.0}));
+  }
+  return Step::kCarryOn;
+}
+
+// ---- check: limit detectors, then the state machine
+
+RigLoop::Step RigLoop::check(RunState& run) noexcept {
+  const DetectorResult& trips = judge_limits(run);
+  return step_state_machine(trips, run);
+}
+
+// The detectors judge this tick's sample against what the previous tick
+// commanded (that is what acted on the rig until now).
+const DetectorResult& RigLoop::judge_limits(RunState& run) noexcept {
+  DetectorInputs in;
+  in.sample = &run.record.sample;
+  in.now_ns = run.woke_ns;
+  in.demand = run.previous_demand;
+  in.command = &run.previous_command;
+  in.valve_driven = machine_.valve_enabled();
+  in.overruns = timing_.overruns();
+  const DetectorResult& trips = detectors_.check(in);
+  const std::size_t kept = trips.new_count < kMaxTripsPerTick ? trips.new_count : kMaxTripsPerTick;
+  for (std::size_t i = 0; i < kept; ++i) {
+    const Event trip = trips.new_trips[i].event();
+    if (trip.action > run.worst_trip.action) run.worst_trip = trip;
+    events_.log(loop_event(run.tick, run.t_ns(), machine_.state(), trip));
+  }
+  return trips;
+}
+
+RigLoop::Step RigLoop::step_state_machine(const DetectorResult& trips, RunState& run) noexcept {
+  MachineInputs in;
+  in.limit_action = trips.action;
+  in.faults_present = trips.faults_present;
+  in.feedback_valid = !trips.feedback_invalid;
+  in.feedback = run.record.sample.value[static_cast<std::size_t>(run.feedback_input)];
+  run.feedback = in.feedback;
+  events_.begin_tick();
+  const SafetyState before = machine_.state();
+  machine_.begin_tick(in, run.worst_trip.code);
+  const bool faulted_now = machine_.state() == SafetyState::kFaulted && before != SafetyState::kFaulted;
+  if (faulted_now) {
+    driver_.make_safe();  // a fault puts the valve to its safe command at once
+    run.valve_was_enabled = false;
+  }
+  if (!safety_.auto_sequence) return Step::kCarryOn;
+  // Without an operator an interlock or a fault ends the run on this tick,
+  // before anything is written (what `rigctl run` has always done).
+  if (trips.action == LimitAction::kInterlock) {
+    events_.log_state_changes(machine_, run.tick, run.t_ns());
+    run.end_event = run.worst_trip.code != EventCode::kNone ? run.worst_trip : trips.worst_new.event();
+    run.ended_by_fault = true;
+    return Step::kEndRun;
+  }
+  if (faulted_now) {
+    events_.log_state_changes(machine_, run.tick, run.t_ns());
+    const StateChange& last = machine_.changes()[machine_.change_count() - 1];
+    run.end_event = Event{last.cause, -1, 0.0};
+    run.ended_by_fault = true;
+    return Step::kEndRun;
+  }
+  return Step::kCarryOn;
+}
+
+// ---- commands
+
+void RigLoop::take_commands(RunState& run) noexcept {
+  commands_.take([&](const OperatorCommand& c, const CommandSource& source) {
+    return apply_command(c, source.origin(), source.logs_refusals(), run).accepted;
+  });
+  events_.log_state_changes(machine_, run.tick, run.t_ns());
+}
+
+// One command through the state machine, with its consequences for the
+// detectors, the controller and the profile, and its event.
+CommandResult RigLoop::apply_command(const OperatorCommand& c, EventSource source, bool log_refusal,
+                                     RunState& run) noexcept {
+  const CommandResult r = machine_.apply(c);
+  if (r.accepted) on_accepted(c, source, r, run);
+  if (r.accepted || log_refusal) log_command(c, source, r, run);
+  events_.log_state_changes(machine_, run.tick, run.t_ns());  // the state change right after its command
+  return r;
+}
+
+void RigLoop::on_accepted(const OperatorCommand& c, EventSource source, const CommandResult& r, RunState& run) noexcept {
+  if (r.reset_latches) {
+    detectors_.clear_latches();
+    run.worst_trip = Event{};
+  }
+  switch (c.kind) {
+    case OperatorCommandKind::kArm: controller_.reset(); break;  // take over the valve with a fresh integrator
+    case OperatorCommandKind::kStop:
+      if (source == EventSource::kOperator) run.operator_stopped = true;
+      break;
+    case OperatorCommandKind::kStart:
+      run.operator_stopped = false;  // a new test after a re-arm
+      // The profile from its beginning: its clock restarts at this sample.
+      profile_.reset();
+      run.profile_clock.restart_at(run.t_ns());
+      if (options_.start_from_input >= 0) {
+        profile_.start_from(run.record.sample.value[static_cast<std::size_t>(options_.start_from_input)]);
+      }
+      break;
+    default: break;
+  }
+}
+
+void RigLoop::log_command(const OperatorCommand& c, EventSource source, const CommandResult& r, RunState& run) noexcept {
+  EventRecord e = loop_event(run.tick, run.t_ns(), machine_.state(),
+                             r.accepted ? Event{EventCode::kCommandAccepted, -1, c.value, static_cast<uint8_t>(c.kind), 0}
+                                        : Event{EventCode::kCommandRejected, static_cast<int16_t>(c.kind), c.value,
+                                                static_cast<uint8_t>(r.reason), 0});
+  e.source = source;
+  e.sequence = c.sequence;
+  events_.log(e);
+  // The record shows what an operator or a signal asked for; the automatic
+  // sequence's commands are only in the event log.
+  if (source == EventSource::kOperator || source == EventSource::kSignal) run.command_event = e.event;
+}
+
+// ---- demand
+
+void RigLoop::demand(RunState& run) noexcept {
+  run.valve_enabled = machine_.valve_enabled();
+  if (!run.valve_enabled && run.valve_was_enabled) driver_.make_safe();  // disarmed on this tick
+  if (run.tick > 0 && !machine_.profile_clock_running()) run.profile_clock.freeze_for(run.t_ns() - run.previous_t_ns);
+  run.demand = run.previous_demand;
+  if (!run.valve_enabled) return;
+  const double profile = machine_.demand_mode() == DemandMode::kProfile ? profile_value(run) : 0.0;
+  run.demand = machine_.next_demand(profile);
+}
+
+double RigLoop::profile_value(RunState& run) noexcept {
+  const double t_profile = run.profile_clock.profile_time_s(run.t_ns());
+  const double value = profile_.next(t_profile);
+  // Operator mode: at the profile's end the rig holds and waits for the operator.
+  if (!safety_.auto_sequence && t_profile - run.profile_clock.first_s() >= profile_.raw().duration()) {
+    machine_.profile_finished();
+    events_.log_state_changes(machine_, run.tick, run.t_ns());
+  }
+  return value;
+}
+
+// ---- control + write
+
+void RigLoop::control_and_write(RunState& run) {
+  TelemetryRecord& r = run.record;
+  if (run.valve_enabled) {
+    controller_.update(run.demand, r.sample, r.command, r.controller);
+    driver_.write(r.command);
+    if (machine_.state() == SafetyState::kRunning) run.ever_ran = true;
+  } else {
+    // The driver holds its safe command (Driver::make_safe, the one place
+    // it is defined); nothing is written, the record shows no command.
+    r.controller.setpoint = run.demand;
+    r.controller.measurement = run.feedback;
+  }
+}
+
+// ---- hand-off
+
+void RigLoop::hand_off(RunState& run) noexcept {
+  TelemetryRecord& r = run.record;
+  r.state = coarse_state(machine_.state(), run.ever_ran);
+  r.safety_state = machine_.state();
+  r.valve_enabled = run.valve_enabled;
+  r.event = record_event(run);
+  run.deadline_ns = timing_.on_done(run.deadline_ns, run.woke_ns, clock_.now_ns());
+  const bool timing_due = options_.timing_every_ticks > 0 && (run.tick + 1) % options_.timing_every_ticks == 0;
+  emit(r, timing_due);
+  // What the next tick's sample is judged against.
+  run.previous_t_ns = run.t_ns();
+  run.previous_demand = run.demand;
+  run.previous_command = run.valve_enabled ? r.command : Command{};
+  run.valve_was_enabled = run.valve_enabled;
+}
+
+// The record's one event: the run's start, else this tick's worst new trip,
+// else the operator's or signal's command.
+Event RigLoop::record_event(const RunState& run) const noexcept {
+  if (run.tick == 0) return Event{EventCode::kRunStarted, -1, 0.0};
+  const DetectorResult& trips = detectors_.last();
+  return trips.new_count > 0 ? trips.worst_new.event() : run.command_event;
+}
+
+void RigLoop::emit(TelemetryRecord& record, bool with_timing) noexcept {
+  record.has_timing = with_timing;
+  if (with_timing) record.timing = timing_.summary();
+  if (!telemetry_.push(record)) ++dropped_;
+}
+
+// ---- end of run
+
+RigLoop::Step RigLoop::decide_end(RunState& run) noexcept {
+  if (run.tick + 1 >= options_.max_ticks && !run.run_length_reached) stop_at_run_length(run);
+  // Operator mode ends when the operator has stopped the rig and then turned
+  // the hydraulics off: the test is over and the rig is safe.
+  const bool operator_done = !safety_.auto_sequence && run.operator_stopped && machine_.state() == SafetyState::kOff;
+  if (operator_done && !run.stop_request_seen) run.end_event = Event{EventCode::kStopRequested, -1, 0.0};
+  const bool finishing =
+      run.run_length_reached || run.stop_request_seen || operator_done || (safety_.auto_sequence && run.ever_ran);
+  const bool rig_safe = !machine_.valve_enabled() && machine_.state() != SafetyState::kStopping;
+  const bool ends = finishing && rig_safe;
+  if (ends && safety_.auto_sequence && machine_.hydraulics() != HydraulicsStage::kOff &&
+      machine_.state() != SafetyState::kFaulted) {
+    apply_command(kHydraulicsOffCommand, EventSource::kAutomatic, true, run);
+  }
+  events_.log_state_changes(machine_, run.tick, run.t_ns());
+  return ends ? Step::kEndRun : Step::kCarryOn;
+}
+
+// The run's length reached: a controlled stop (ramp to hold, disarm), and
+// the automatic sequence never starts the rig again.
+void RigLoop::stop_at_run_length(RunState& run) noexcept {
+  run.run_length_reached = true;
+  commands_.run_ending();
+  if (machine_.valve_enabled()) apply_command(kStopCommand, EventSource::kAutomatic, true, run);
+}
+
+// ---- after the last tick
+
+LoopResult RigLoop::finish_run(RunState& run) noexcept {
   // A trip that held or stopped the rig makes the run a faulted one, even
   // when the stop itself was controlled.
-  if (!ended_by_fault && worst_trip.action >= static_cast<uint8_t>(LimitAction::kHold)) {
-    ended_by_fault = true;
-    end_event = worst_trip;
+  if (!run.ended_by_fault && run.worst_trip.action >= static_cast<uint8_t>(LimitAction::kHold)) {
+    run.ended_by_fault = true;
+    run.end_event = run.worst_trip;
   }
-  const RigState end_state = ended_by_fault ? RigState::kFaulted : RigState::kStopped;
+  const RigState end_state = run.ended_by_fault ? RigState::kFaulted : RigState::kStopped;
 
   // The closing record: why the run ended, and the final timing statistics.
-  record.tick = tick;
-  record.has_sample = false;
-  record.state = end_state;
-  record.safety_state = machine_.state();
-  record.valve_enabled = false;
-  record.event = end_event;
-  emit(record, true);
-  {
-    EventRecord e;
-    e.tick = tick;
-    e.t_ns = prev_t_ns_;
-    e.state = machine_.state();
-    e.event = end_event;
-    e.source = end_event.code != EventCode::kStopRequested ? EventSource::kLoop
-               : operator_stopped && !stop_seen               ? EventSource::kOperator
+  TelemetryRecord& closing = run.record;
+  closing.tick = run.tick;
+  closing.has_sample = false;
+  closing.state = end_state;
+  closing.safety_state = machine_.state();
+  closing.valve_enabled = false;
+  closing.event = run.end_event;
+  emit(closing, true);
+  EventRecord e = loop_event(run.tick, run.previous_t_ns, machine_.state(), run.end_event);
+  e.source = run.end_event.code != EventCode::kStopRequested ? EventSource::kLoop
+             : run.operator_stopped && !run.stop_request_seen ? EventSource::kOperator
                                                               : EventSource::kSignal;
-    log_event(e);
-  }
+  events_.log(e);
 
-  result.ticks = tick;
+  LoopResult result;
+  result.ticks = run.tick;
   result.final_state = end_state;
   result.final_safety_state = machine_.state();
-  result.end_event = end_event;
+  result.end_event = run.end_event;
   result.timing = timing_.summary();
   result.dropped_records = dropped_;
-  result.dropped_events = dropped_events_;
+  result.dropped_events = events_.dropped();
   return result;
 }
 

@@ -1,8 +1,20 @@
-// The fixed-period control loop. One tick:
-//   sleep to the absolute deadline -> driver.read -> limit detectors
-//   -> state machine (limit actions, operator and automatic commands)
-//   -> demand (profile, or a ramp to hold) -> controller -> driver.write
-//   -> telemetry record into a lock-free queue, events into the event sink
+// The fixed-period control loop. One tick, each step a member function on
+// the run's state (rt/loop/run_state.hpp):
+//   wait      sleep to the absolute deadline, record the wake-up latency;
+//             a stop request seen here ends the run at once if the valve is safe
+//   read      driver.read fills the tick's sample
+//   check     the limit detectors judge it against the previous tick's demand
+//             and command; the state machine takes their action (a fault
+//             makes the valve safe at once; without an operator an interlock
+//             or a fault ends the run here, before anything is written)
+//   commands  the command sources in order (rt/loop/command_sources.hpp):
+//             a stop request, the operator's queue, the automatic sequence
+//   demand    the profile (or a ramp to hold) through the state machine
+//   control + write  controller.update, driver.write (or nothing: valve safe)
+//   hand-off  one telemetry record into the sink; events went to the event
+//             sink as they happened
+//   end of run  at max_ticks a controlled stop; the run ends once the rig is
+//             safe (and, without an operator, hydraulics off)
 // Nothing on this path allocates, locks, logs or formats; events are codes
 // that the publisher and event-log threads turn into text.
 #pragma once
@@ -10,17 +22,19 @@
 #include <atomic>
 #include <cstdint>
 
-#include "rt/driver.hpp"
-#include "rt/control/controller.hpp"
 #include "rt/comms/event_sink.hpp"
-#include "rt/safety/limit_check.hpp"
-#include "rt/safety/limit_detectors.hpp"
+#include "rt/comms/telemetry_sink.hpp"
+#include "rt/control/controller.hpp"
+#include "rt/control/setpoint_profile.hpp"
+#include "rt/driver.hpp"
+#include "rt/loop/command_sources.hpp"
+#include "rt/loop/loop_events.hpp"
+#include "rt/loop/run_state.hpp"
 #include "rt/loop_clock.hpp"
+#include "rt/safety/limit_detectors.hpp"
 #include "rt/safety/operator_command.hpp"
 #include "rt/safety/rig_state_machine.hpp"
-#include "rt/control/setpoint_profile.hpp"
 #include "rt/spsc_queue.hpp"
-#include "rt/comms/telemetry_sink.hpp"
 #include "rt/timing_stats.hpp"
 
 namespace rigctl {
@@ -58,17 +72,15 @@ struct LoopResult {
 
 class RigLoop {
  public:
-  // Today's interface: the LimitCheck as interlock detectors, the automatic
-  // sequence, no operator.
-  RigLoop(Driver& driver, Controller& controller, FilteredProfile& profile, const LimitCheck& limits,
-          TelemetrySink& telemetry, LoopClock& clock, const LoopOptions& options);
+  // The rig as `rigctl run` assembles it (tools/run/rig_assembly.hpp): its
+  // limit detectors and the state machine's settings.
   RigLoop(Driver& driver, Controller& controller, FilteredProfile& profile, LimitDetectors detectors,
           TelemetrySink& telemetry, LoopClock& clock, const LoopOptions& options, const SafetyOptions& safety);
 
   // Optional inputs, set before run(): authenticated operator commands (the
   // LCM receiver pushes them) and the durable event log.
-  void set_operator_commands(SpscQueue<OperatorCommand>* commands) { commands_ = commands; }
-  void set_event_sink(EventSink* events) { events_ = events; }
+  void set_operator_commands(SpscQueue<OperatorCommand>* commands) { commands_.attach_operator_queue(commands); }
+  void set_event_sink(EventSink* events) { events_.attach(events); }
 
   // Runs until the rig is stopped (max_ticks or stop_requested: a controlled
   // stop) or faulted (automatic sequence). stop_requested is set from a
@@ -79,11 +91,32 @@ class RigLoop {
   const RigStateMachine& machine() const { return machine_; }
 
  private:
+  // Whether the run goes on after a step.
+  enum class Step : uint8_t { kCarryOn, kEndRun };
+
+  void begin_run(RunState& run) noexcept;
+  // The tick's steps, in order.
+  void wait(RunState& run) noexcept;
+  Step notice_stop_request(const std::atomic<bool>& stop_requested, RunState& run) noexcept;
+  Step read(RunState& run);
+  Step check(RunState& run) noexcept;
+  void take_commands(RunState& run) noexcept;
+  void demand(RunState& run) noexcept;
+  void control_and_write(RunState& run);
+  void hand_off(RunState& run) noexcept;
+  Step decide_end(RunState& run) noexcept;
+  LoopResult finish_run(RunState& run) noexcept;
+
+  // Parts of the steps.
+  const DetectorResult& judge_limits(RunState& run) noexcept;
+  Step step_state_machine(const DetectorResult& trips, RunState& run) noexcept;
+  CommandResult apply_command(const OperatorCommand& c, EventSource source, bool log_refusal, RunState& run) noexcept;
+  void on_accepted(const OperatorCommand& c, EventSource source, const CommandResult& r, RunState& run) noexcept;
+  void log_command(const OperatorCommand& c, EventSource source, const CommandResult& r, RunState& run) noexcept;
+  double profile_value(RunState& run) noexcept;
+  Event record_event(const RunState& run) const noexcept;
+  void stop_at_run_length(RunState& run) noexcept;
   void emit(TelemetryRecord& record, bool with_timing) noexcept;
-  void log_event(const EventRecord& e) noexcept;
-  void log_changes(int64_t tick, int64_t t_ns) noexcept;
-  CommandResult command(const OperatorCommand& c, EventSource source, int64_t tick, int64_t t_ns, bool log_refusal) noexcept;
-  RigState coarse_state() const noexcept;
 
   Driver& driver_;
   Controller& controller_;
@@ -95,15 +128,9 @@ class RigLoop {
   SafetyOptions safety_;
   RigStateMachine machine_;
   TimingStats timing_;
-  SpscQueue<OperatorCommand>* commands_ = nullptr;
-  EventSink* events_ = nullptr;
-  int64_t dropped_ = 0;
-  int64_t dropped_events_ = 0;
-  std::size_t changes_logged_ = 0;
-  bool ever_ran_ = false;
-  // Profile clock: sample time minus the time the profile was not running.
-  int64_t first_t_ns_ = 0, prev_t_ns_ = 0, frozen_ns_ = 0;
-  bool start_pending_ = false;
+  CommandSources commands_;
+  LoopEvents events_;
+  int64_t dropped_ = 0;  // telemetry records the sink refused
 };
 
 }  // namespace rigctl

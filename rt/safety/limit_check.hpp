@@ -1,7 +1,8 @@
 // Per-tick plausibility and range checks on the inputs (the config's
-// `limits:`). The first violation found is reported as an event. The loop
-// runs these as interlock detectors of rt/safety/limit_detectors.hpp
-// (LimitDetectors::from_limit_check), next to the `safety:` detectors.
+// `limits:`). The first violation found is reported as an event. Nothing on
+// the loop uses it any more: rig assembly turns `limits:` into range
+// detectors (rt/safety/limit_detectors.hpp) beside the `safety:` ones. Only
+// AssembledRig::limits still builds one; this header goes with that field.
 #pragma once
 
 #include <cmath>

@@ -59,27 +59,6 @@ LimitDetectors::LimitDetectors(std::vector<DetectorSpec> specs, std::size_t inpu
   }
 }
 
-LimitDetectors LimitDetectors::from_limit_check(const LimitCheck& limits, double period_s) {
-  std::vector<DetectorSpec> specs;
-  for (std::size_t i = 0; i < limits.input_count(); ++i) {
-    DetectorSpec s;
-    s.name = "invalid";
-    s.kind = DetectorKind::kInvalid;
-    s.channel = static_cast<int>(i);
-    specs.push_back(s);
-  }
-  for (const auto& l : limits.limits()) {
-    DetectorSpec s;
-    s.name = "limits";
-    s.kind = DetectorKind::kRange;
-    s.channel = l.input;
-    s.min = l.min;
-    s.max = l.max;
-    specs.push_back(s);
-  }
-  return LimitDetectors(std::move(specs), limits.input_count(), -1, period_s);
-}
-
 bool LimitDetectors::condition(const DetectorSpec& s, State& st, const DetectorInputs& in, double& value) noexcept {
   const Sample& sample = *in.sample;
   const auto ch = static_cast<std::size_t>(s.channel < 0 ? 0 : s.channel);

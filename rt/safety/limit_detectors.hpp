@@ -13,7 +13,6 @@
 
 #include "rt/safety/detector_kind.hpp"
 #include "rt/safety/limit_action.hpp"
-#include "rt/safety/limit_check.hpp"
 #include "rt/sample.hpp"
 #include "rt/telemetry_record.hpp"
 
@@ -77,9 +76,6 @@ class LimitDetectors {
   // valve may be driven); -1: every input. period_s turns durations into ticks.
   LimitDetectors(std::vector<DetectorSpec> specs, std::size_t input_count, int feedback_input, double period_s);
 
-  // Today's LimitCheck as detectors: every input checked for invalid, listed
-  // inputs for range, each an interlock (the run ends faulted).
-  static LimitDetectors from_limit_check(const LimitCheck& limits, double period_s);
 
   // Loop thread. Updates every detector and returns this tick's summary.
   const DetectorResult& check(const DetectorInputs& in) noexcept;

@@ -47,7 +47,10 @@ CommandSeries closed_loop_commands(const RigConfig& config, int64_t ticks) {
   o.start_from_input = rig.profile_start_input;
   o.timing_every_ticks = 0;
   rig.driver->start();
-  RigLoop loop(*rig.driver, *rig.controller, *rig.profile, rig.limits, sink, clock, o);
+  // The rig as `rigctl run --fast` runs it: the configured detectors and
+  // state machine, the automatic sequence (no operator here).
+  rig.safety.auto_sequence = true;
+  RigLoop loop(*rig.driver, *rig.controller, *rig.profile, rig.detectors, sink, clock, o, rig.safety);
   const std::atomic<bool> never{false};
   loop.run(never);
   rig.driver->stop();

@@ -301,12 +301,16 @@ SuspensionRecording run_half_car(const RigConfig& config, ControllerKind control
   options.overrun_policy = c.loop.overrun_policy;
   options.max_ticks = std::llround(duration_s / c.loop.period_s);
   options.timing_every_ticks = std::max<int64_t>(1, std::llround(c.loop.timing_publish_s / c.loop.period_s));
+  options.start_from_input = rig.profile_start_input;
   if (options.max_ticks < 1) throw std::runtime_error("run duration must be at least one period");
 
   RecordingSink sink(sim->plant(), rec, static_cast<std::size_t>(options.max_ticks) + 1, keep_rows);
   VirtualClock clock;
   rig.driver->start();
-  RigLoop loop(*rig.driver, *rig.controller, *rig.profile, rig.limits, sink, clock, options);
+  // The rig as `rigctl run --fast` runs it: the configured detectors and
+  // state machine, the automatic sequence (no operator here).
+  rig.safety.auto_sequence = true;
+  RigLoop loop(*rig.driver, *rig.controller, *rig.profile, rig.detectors, sink, clock, options, rig.safety);
   const std::atomic<bool> stop{false};
   rec.loop = loop.run(stop);
   rig.driver->stop();

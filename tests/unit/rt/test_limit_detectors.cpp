@@ -207,24 +207,6 @@ TEST(LimitDetectors, TheMostSevereNewTripIsReportedAndEveryTripIsListed) {
   EXPECT_EQ(r.new_trips[2].action, LimitAction::kHold);
 }
 
-TEST(LimitDetectors, FromLimitCheckKeepsTheOldChecks) {
-  const LimitCheck old({{1, -1.0, 1.0}}, 2);
-  LimitDetectors d = LimitDetectors::from_limit_check(old, kT);
-  Sample s;
-  DetectorInputs in;
-  in.sample = &s;
-  s.value[1] = 1.5;
-  const Event expected = old.check(s);
-  const auto& r = d.check(in);
-  EXPECT_EQ(r.action, LimitAction::kInterlock);
-  EXPECT_EQ(r.worst_new.code, expected.code);
-  EXPECT_EQ(r.worst_new.channel, expected.channel);
-  s.value[1] = 0.0;
-  s.value[0] = std::nan("");
-  EXPECT_EQ(d.check(in).worst_new.code, EventCode::kInputInvalid);
-  EXPECT_EQ(d.last().worst_new.channel, 0);
-}
-
 TEST(LimitDetectors, CheckDoesNotAllocate) {
   auto over = spec(DetectorKind::kOverruns, -1);
   over.max_count = 1;

@@ -74,11 +74,29 @@ struct Fixture {
   ScriptedClock clock;
   ScriptedDriver driver{clock};
   PiController pi{PiConfig{}};
-  FilteredProfile profile{std::make_unique<RampStepsProfile>(LeadIn{0.0, 0.0, 0.0, 1.0}, std::vector<double>{0.01}, 100.0),
+  // A demand at rest where the rod is: the controlled stop at max_ticks
+  // settles at once, so a run of N ticks is N ticks (these tests are about
+  // scheduling; tests/unit/rt/test_rig_loop_safety.cpp ramps).
+  FilteredProfile profile{std::make_unique<RampStepsProfile>(LeadIn{0.0, 0.0, 0.0, 1.0}, std::vector<double>{0.0}, 100.0),
                           0.0, 0.0025};
-  LimitCheck limits{{{0, -1.0, 1.0}}, 1};
   CollectingSink sink;
   std::atomic<bool> stop{false};
+
+  // What rig assembly makes of `limits: {x: [-1, 1]}`: the input's
+  // plausibility, then its range, both interlocks.
+  static LimitDetectors detectors() {
+    DetectorSpec invalid;
+    invalid.name = "invalid.x";
+    invalid.kind = DetectorKind::kInvalid;
+    invalid.channel = 0;
+    DetectorSpec range;
+    range.name = "limits.x";
+    range.kind = DetectorKind::kRange;
+    range.channel = 0;
+    range.min = -1.0;
+    range.max = 1.0;
+    return LimitDetectors({invalid, range}, 1, 0, 0.0025);
+  }
 
   LoopResult run(int64_t ticks, OverrunPolicy policy = OverrunPolicy::kSkip, int64_t timing_every = 10) {
     LoopOptions o;
@@ -86,7 +104,9 @@ struct Fixture {
     o.overrun_policy = policy;
     o.max_ticks = ticks;
     o.timing_every_ticks = timing_every;
-    RigLoop loop(driver, pi, profile, limits, sink, clock, o);
+    SafetyOptions s;  // the automatic sequence of `rigctl run`, the state machine's default rates
+    s.feedback_input = 0;
+    RigLoop loop(driver, pi, profile, detectors(), sink, clock, o, s);
     return loop.run(stop);
   }
 };

@@ -20,6 +20,7 @@
 #include "rt/control/lqr_controller.hpp"
 #include "rt/loop/rig_loop.hpp"
 #include "rt/control/skyhook_controller.hpp"
+#include "tests/support/plausibility_detectors.hpp"
 #include "tools/suspension/suspension_metrics.hpp"
 
 using namespace rigctl;
@@ -87,12 +88,19 @@ Recorded run_closed_loop(Controller& controller, const HalfCarParams& params, do
   RecordingSink sink(plant_ref);
   FilteredProfile profile(std::make_unique<TableProfile>(std::vector<double>{0.0, duration}, std::vector<double>{0.0, 0.0}),
                           0.0, kPeriod);
-  LimitCheck limits({}, driver.layout().inputs.size());
   VirtualClock clock;
   LoopOptions options;
   options.max_ticks = std::lround(duration / kPeriod);
   driver.start();
-  RigLoop loop(driver, controller, profile, limits, sink, clock, options);
+  // As `rigctl run` runs config/half_car.yaml: the automatic sequence arms
+  // on the measured body heave and holds it at 0 while the road moves under it.
+  SafetyOptions safety;
+  safety.feedback_input = static_cast<int>(sig::kZs);
+  safety.machine.hold_deceleration = 1.0;  // [m/s^2]
+  safety.machine.setpoint_rate = 0.05;     // [m/s]
+  RigLoop loop(driver, controller, profile,
+               test::plausibility_detectors(driver.layout().inputs.size(), safety.feedback_input, kPeriod), sink, clock,
+               options, safety);
   std::atomic<bool> stop{false};
   Recorded out;
   out.result = loop.run(stop);

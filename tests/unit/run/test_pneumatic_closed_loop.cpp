@@ -27,6 +27,7 @@
 #include "plant/pneumatic_rotary/pneumatic_rotary_plant.hpp"
 #include "rt/control/pvp_controller.hpp"
 #include "rt/loop/rig_loop.hpp"
+#include "tests/support/plausibility_detectors.hpp"
 #include "tests/support/step_metrics.hpp"
 
 namespace rigctl {
@@ -115,7 +116,6 @@ Run run_loop(const Case& c, std::unique_ptr<SetpointProfile> profile, double dur
   config.period_s = kPeriod;
   PvpController controller(config);
   FilteredProfile demand(std::move(profile), 0.0, kPeriod);  // a true step, as in the paper
-  const LimitCheck limits;
   RecordingSink sink(plant, run);
   VirtualClock clock;
   LoopOptions options;
@@ -126,7 +126,18 @@ Run run_loop(const Case& c, std::unique_ptr<SetpointProfile> profile, double dur
   primed.theta = theta0;
   primed.anchor.theta = theta0;  // hysteresis unloaded there
   plant.set_state(primed);
-  RigLoop loop(driver, controller, demand, limits, sink, clock, options);
+  // As `rigctl run` runs config/pneumatic_rotary.yaml: the automatic
+  // sequence arms on the measured angle and starts the profile from there;
+  // its rates shape only the start (the arm sits on the first demand) and
+  // the stop (the demand is at rest by then): the paper's step itself goes
+  // through unshaped.
+  SafetyOptions safety;
+  safety.feedback_input = static_cast<int>(pneumatic_rotary_signal::kTheta);
+  safety.machine.hold_deceleration = 5.0;  // [rad/s^2]
+  safety.machine.setpoint_rate = 0.2;      // [rad/s]
+  RigLoop loop(driver, controller, demand,
+               test::plausibility_detectors(driver.layout().inputs.size(), safety.feedback_input, kPeriod), sink, clock,
+               options, safety);
   const std::atomic<bool> stop{false};
   const LoopResult result = loop.run(stop);
   EXPECT_EQ(result.final_state, RigState::kStopped);

@@ -64,8 +64,10 @@ StepRun run_step_test(bool friction) {
   VirtualClock clock;
   LoopOptions options;
   options.max_ticks = std::lround(rig.profile_duration_s / run.config.loop.period_s);
+  options.start_from_input = rig.profile_start_input;
   rig.driver->start();
-  RigLoop loop(*rig.driver, *rig.controller, *rig.profile, rig.limits, sink, clock, options);
+  // As `rigctl run` runs it: the configured detectors and state machine.
+  RigLoop loop(*rig.driver, *rig.controller, *rig.profile, rig.detectors, sink, clock, options, rig.safety);
   std::atomic<bool> stop{false};
   run.result = loop.run(stop);
   run.ticks = std::move(sink.ticks);
