@@ -350,15 +350,6 @@ AssembledRig assemble_rig(const RigConfig& c) {
 
   rig.controller = make_controller(c, layout);
 
-  std::vector<InputLimit> limits;
-  for (const auto& l : c.limits) {
-    const int index = layout.input_index(l.channel);
-    if (index < 0) {
-      config_fail(c, "limits." + l.channel, "unknown input channel (inputs: " + channel_list(layout.inputs) + ")");
-    }
-    limits.push_back({index, l.min, l.max});
-  }
-  rig.limits = LimitCheck(std::move(limits), layout.inputs.size());
   const int feedback = layout.input_index(c.controller.feedback);
   rig.detectors = make_detectors(c, layout, feedback);
   rig.safety = make_safety(c, feedback);

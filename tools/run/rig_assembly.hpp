@@ -11,7 +11,6 @@
 #include "rt/driver.hpp"
 #include "plant/simulated_plant.hpp"
 #include "rt/control/controller.hpp"
-#include "rt/safety/limit_check.hpp"
 #include "rt/safety/limit_detectors.hpp"
 #include "rt/loop/rig_loop.hpp"
 #include "rt/control/setpoint_profile.hpp"
@@ -22,7 +21,6 @@ struct AssembledRig {
   std::unique_ptr<Driver> driver;
   std::unique_ptr<Controller> controller;
   std::unique_ptr<FilteredProfile> profile;
-  LimitCheck limits;          // the `limits:` ranges alone (benchmarks, the legacy loop constructor)
   LimitDetectors detectors;   // every input's plausibility, `limits:` and `safety.detectors`
   SafetyOptions safety;       // the state machine's settings from `safety:`
   std::string setpoint_name;  // run-file column of the demand, e.g. "x_ref"
