@@ -242,7 +242,10 @@ void CanopenValve::on_sdo(const CanFrame& f, int64_t now_ns) {
   switch (r.kind) {
     case SdoResult::Kind::kMalformed: count_malformed(r.malformed, f); return;
     case SdoResult::Kind::kIgnored: counters_.ignored.fetch_add(1, std::memory_order_relaxed); return;
-    case SdoResult::Kind::kPending: return;
+    case SdoResult::Kind::kPending:  // a segment of a segmented upload: ask for the next
+      counters_.accepted.fetch_add(1, std::memory_order_relaxed);
+      if (r.to_send) send(*r.to_send);
+      return;
     default:
       counters_.accepted.fetch_add(1, std::memory_order_relaxed);
       if (r.to_send) send(*r.to_send);
