@@ -230,6 +230,11 @@ void SimCanopenValve::reset_node() {
   reset_communication(now_ns(), true);
 }
 
+void SimCanopenValve::lose_sdo_answers(int count) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  sdo_answers_to_lose_ = std::max(0, count);
+}
+
 void SimCanopenValve::drop_to_hold(double duration_s) {
   std::lock_guard<std::mutex> lock(mutex_);
   dsm_.force_hold(now_ns() + static_cast<int64_t>(std::max(0.0, duration_s) * 1e9));

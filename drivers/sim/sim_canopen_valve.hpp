@@ -95,7 +95,7 @@ class SimCanopenValve {
     uint64_t master_heartbeat_losses = 0;
     uint64_t malformed = 0;       // frames received and dropped
     uint64_t boot_ups = 0;        // boot-up messages sent
-    uint64_t ignored_while_booting = 0;  // frames received while initialising (a real node is deaf then)
+    uint64_t sdo_while_booting = 0;  // SDO requests received while initialising (ignored: a real node is deaf then)
     uint64_t rpdo_timeouts = 0;
     uint64_t pdo_length_errors = 0;
   };
@@ -115,6 +115,7 @@ class SimCanopenValve {
   void send_raw_record(std::vector<uint8_t> bytes);    // a record that is not 16 bytes
   void reset_node();                      // the valve resets itself (boot-up, pre-operational)
   void drop_to_hold(double duration_s);   // an internal event holds an ACTIVE valve in HOLD for a while
+  void lose_sdo_answers(int count);       // the next `count` SDO answers are lost on the way
 
  private:
   struct Outgoing {
@@ -179,6 +180,7 @@ class SimCanopenValve {
   int64_t fail_safe_ns_ = 0;
   bool silent_ = false;
   bool drop_requested_ = false;
+  int sdo_answers_to_lose_ = 0;
   Stats stats_;
 
   std::atomic<double> spool_{0.0};

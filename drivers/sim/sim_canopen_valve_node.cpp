@@ -77,12 +77,15 @@ void SimCanopenValve::finish_boot(int64_t now) {
 // ---------------------------------------------------------------- frames
 
 void SimCanopenValve::handle(const CanFrame& f, int64_t now) {
+  CobInfo info;
+  const Malformed m = check_frame(f, info);
   if (booting(now)) {
-    ++stats_.ignored_while_booting;
+    if (m == Malformed::kNone && info.function == Function::kSdoRx && info.node == config_.node_id) {
+      ++stats_.sdo_while_booting;
+    }
     return;
   }
-  CobInfo info;
-  if (check_frame(f, info) != Malformed::kNone) {
+  if (m != Malformed::kNone) {
     ++stats_.malformed;
     return;
   }
@@ -159,7 +162,11 @@ void SimCanopenValve::handle_sdo(const CanFrame& f, int64_t now) {
   Malformed why = Malformed::kNone;
   const auto response = sdo_->on_frame(f, &why);
   if (why != Malformed::kNone) ++stats_.malformed;
-  if (response) queue(*response, now);
+  if (response && sdo_answers_to_lose_ > 0) {
+    --sdo_answers_to_lose_;
+  } else if (response) {
+    queue(*response, now);
+  }
   if (sdo_->writes() != writes) {
     ++stats_.sdo_writes;
     after_write(get_u16le(&f.data[1]), f.data[3], now);
