@@ -219,8 +219,7 @@ class CanopenValve {
   void set_spool_scale(int full_scale);
   void configure_pdos(int64_t deadline_ns);
   void set_up_pdo(const canopen::PdoSetup& setup, int64_t deadline_ns);
-  canopen::PdoSetup setpoint_pdo() const;
-  canopen::PdoSetup actual_pdo() const;
+  canopen::PdoSetup pdo_setup(canopen::PdoDirection direction) const;  // the setpoint RPDO or the actual-value TPDO
   void walk_to_active(int64_t deadline_ns);
   // Handles frames until done(); past deadline_ns fails with "no WHAT within
   // LIMIT" (LIMIT: the start-up timeout unless given).

@@ -19,30 +19,22 @@ namespace {
 uint16_t whole_ms(double s) { return static_cast<uint16_t>(std::lround(s * 1000.0)); }
 }  // namespace
 
-PdoSetup CanopenValve::setpoint_pdo() const {
+PdoSetup CanopenValve::pdo_setup(PdoDirection direction) const {
+  const bool setpoint = direction == PdoDirection::kReceive;
   PdoSetup s;
-  s.direction = PdoDirection::kReceive;
-  s.number = config_.setpoint_rpdo;
-  s.cob_id = setpoint_cob_;
-  s.mapping = rpdo_map_;
-  // For an RPDO the event timer is the deadline of the next setpoint.
-  s.event_timer_ms = whole_ms(config_.setpoint_timeout_s);
-  return s;
-}
-
-PdoSetup CanopenValve::actual_pdo() const {
-  PdoSetup s;
-  s.direction = PdoDirection::kTransmit;
-  s.number = config_.actual_tpdo;
-  s.cob_id = actual_cob_;
-  s.mapping = tpdo_map_;
-  s.event_timer_ms = whole_ms(config_.actual_period_s);
+  s.direction = direction;
+  s.number = setpoint ? config_.setpoint_rpdo : config_.actual_tpdo;
+  s.cob_id = setpoint ? setpoint_cob_ : actual_cob_;
+  s.mapping = setpoint ? rpdo_map_ : tpdo_map_;
+  // For an RPDO the event timer is the deadline of the next setpoint; for
+  // a TPDO the period the valve sends it with.
+  s.event_timer_ms = whole_ms(setpoint ? config_.setpoint_timeout_s : config_.actual_period_s);
   return s;
 }
 
 void CanopenValve::configure_pdos(int64_t deadline_ns) {
-  set_up_pdo(setpoint_pdo(), deadline_ns);
-  set_up_pdo(actual_pdo(), deadline_ns);
+  set_up_pdo(pdo_setup(PdoDirection::kReceive), deadline_ns);
+  set_up_pdo(pdo_setup(PdoDirection::kTransmit), deadline_ns);
 }
 
 void CanopenValve::set_up_pdo(const PdoSetup& setup, int64_t deadline_ns) {
