@@ -230,6 +230,11 @@ void SimCanopenValve::reset_node() {
   reset_communication(now_ns(), true);
 }
 
+void SimCanopenValve::fault_device(uint16_t emcy_code) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  enter_fail_safe(now_ns(), emcy_code);
+}
+
 void SimCanopenValve::lose_sdo_answers(int count) {
   std::lock_guard<std::mutex> lock(mutex_);
   sdo_answers_to_lose_ = std::max(0, count);

@@ -116,6 +116,7 @@ class SimCanopenValve {
   void reset_node();                      // the valve resets itself (boot-up, pre-operational)
   void drop_to_hold(double duration_s);   // an internal event holds an ACTIVE valve in HOLD for a while
   void lose_sdo_answers(int count);       // the next `count` SDO answers are lost on the way
+  void fault_device(uint16_t emcy_code);  // a device fault: FAULT_DISABLED/FAULT_HOLD, EMCY, until a fault reset
 
  private:
   struct Outgoing {

@@ -153,9 +153,10 @@ class SdoClient {
   std::optional<CanFrame> start_upload(uint16_t index, uint8_t subindex, int64_t now_ns);
 
   // Feeds a received frame. Frames on other COB-IDs are kIgnored; an SDO
-  // response with no transfer pending is kMalformed (kUnexpectedSdo); one of
-  // the wrong length is kMalformed (kWrongLength) and the transfer stays
-  // pending. During a segmented upload each segment gives kPending with the
+  // response with no transfer pending, or naming another object than the
+  // pending transfer's (a late answer to a request that timed out and was
+  // sent again), is kMalformed (kUnexpectedSdo); one of the wrong length is
+  // kMalformed (kWrongLength); the transfer stays pending after either. During a segmented upload each segment gives kPending with the
   // next segment request in to_send, until the last gives kDone.
   SdoResult on_frame(const CanFrame& frame, int64_t now_ns);
   // kAbort with 0x05040000 once the deadline has passed; else kPending.

@@ -107,23 +107,33 @@ SdoResult SdoClient::on_frame(const CanFrame& frame, int64_t now_ns) {
 }
 
 namespace {
-SdoResult wrong_multiplexer(SdoResult e, uint32_t request_cob, uint16_t index, uint8_t subindex) {
-  e.abort_code = sdo::kAbortGeneral;
-  e.to_send = sdo_abort(request_cob, index, subindex, e.abort_code);
-  return e;
+// An answer naming another object than the pending transfer's: a late
+// answer to an earlier request (one that timed out and was sent again) is
+// the usual one. Dropped, the transfer goes on waiting for its own.
+SdoResult stale_answer(uint16_t index, uint8_t subindex) {
+  SdoResult r;
+  r.kind = SdoResult::Kind::kMalformed;
+  r.malformed = Malformed::kUnexpectedSdo;
+  r.index = index;
+  r.subindex = subindex;
+  r.text = "SDO response for another index/subindex (a late answer to an earlier request?)";
+  return r;
 }
 }  // namespace
 
 SdoResult SdoClient::on_download_response(uint8_t command, uint16_t index, uint8_t subindex) {
+  // The multiplexer is only one in a response of the right kind (scs 3).
+  if ((command & 0xE0) != sdo::kDownloadResponse) return protocol_error("unexpected command byte in download response");
+  if (index != index_ || subindex != subindex_) return stale_answer(index_, subindex_);
   if (command != sdo::kDownloadResponse) return protocol_error("unexpected command byte in download response");
-  if (index != index_ || subindex != subindex_) {
-    return wrong_multiplexer(protocol_error("response for another index/subindex"), request_cob_id(), index_, subindex_);
-  }
   return finish(SdoResult::Kind::kDone);
 }
 
 SdoResult SdoClient::on_upload_response(const CanFrame& frame, int64_t now_ns) {
   const uint8_t command = frame.data[0];
+  // The multiplexer is only one in a response of the right kind (scs 2).
+  if ((command & 0xE0) != sdo::kUploadSegmented) return protocol_error("unexpected command byte in upload response");
+  if (get_u16le(&frame.data[1]) != index_ || frame.data[3] != subindex_) return stale_answer(index_, subindex_);
   uint8_t size = 0;
   bool segmented = false;
   switch (command) {
@@ -135,9 +145,6 @@ SdoResult SdoClient::on_upload_response(const CanFrame& frame, int64_t now_ns) {
     case sdo::kUploadSegmented:
     case sdo::kUploadSegmentedSize: segmented = true; break;
     default: return protocol_error("unexpected command byte in upload response");
-  }
-  if (get_u16le(&frame.data[1]) != index_ || frame.data[3] != subindex_) {
-    return wrong_multiplexer(protocol_error("response for another index/subindex"), request_cob_id(), index_, subindex_);
   }
   const uint32_t data = get_u32le(&frame.data[4]);
   if (segmented) {

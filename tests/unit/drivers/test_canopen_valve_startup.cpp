@@ -419,3 +419,19 @@ TEST(CanopenValve, ValveThatNeverReachesDeviceModeActiveIsRefusedBeforeTheLoopDr
   EXPECT_EQ(sim->od_value(0x6300, 1), 0U);
   EXPECT_EQ(sim->spool(), 0.0);
 }
+
+TEST(CanopenValve, ValveInAFaultStateGetsAFaultResetOnTheWayToDeviceModeActive) {
+  CanopenValveConfig c = client_config();
+  c.reset_on_start = false;  // the fault survives: no reset of the node before
+  auto [a, b] = socketpair_seqpacket();
+  SimCanopenValve sim(std::move(b), sim_config());
+  sim.fault_device(0x5000);  // e.g. left from a previous session
+  ASSERT_EQ(sim.device_state(), State::kFaultDisabled);
+  CanopenValve valve(c);
+  valve.start(std::move(a));
+  EXPECT_EQ(sim.device_state(), State::kActive);
+  EXPECT_TRUE(wait_for([&] { return valid(valve); })) << valve.flag_cause();
+  Diag d(valve);
+  EXPECT_TRUE(d.has_event({"device state FAULT_DISABLED", "control word 0x0009"})) << d.dump();  // D with the reset bit
+  EXPECT_TRUE(d.has_event({"EMCY 0x0000"})) << d.dump();  // the valve's "no error" after the reset
+}
