@@ -1,15 +1,16 @@
 // The shipped quarter-car config for the end-to-end tests on the wire:
 // `rigctl run` with a hardware driver against `rigctl rig-sim` on 127.0.0.1
 // and a seqpacket socket in the test's own folder (test_hardware_in_the_loop,
-// test_fault_matrix).
+// test_fault_matrix, test_canopen_valve_run).
 //
 // Its times are for a loaded 2-core test machine, in two kinds:
-//  * Start-up runs at normal priority (process start, the DAQ's first
-//    sample, the valve's SDO configuration, our heartbeat until the valve
-//    driver's I/O thread takes over): seconds, so a process that is
-//    descheduled or starts from a cold cache only starts later. With an
-//    SDO timeout of 0.1 s (shipped once) a run failed here with "no answer
-//    within sdo_timeout_s = 0.1 s".
+//  * Start-up runs mostly at normal priority (process start, the DAQ's
+//    first sample; the valve's SDO configuration and our heartbeat run at
+//    the valve's io_priority where SCHED_FIFO is permitted, at normal
+//    priority where not): seconds, so a process that is descheduled or
+//    starts from a cold cache only starts later. With an SDO timeout of
+//    0.1 s (shipped once) a run failed here with "no answer within
+//    sdo_timeout_s = 0.1 s".
 //  * Running, the fault-to-safe chain is SCHED_FIFO threads on both sides
 //    (rig-sim's plant and valve, the loop, the drivers' I/O): a CPU hog at
 //    normal priority cannot delay it, the stalls of a shared VM can, by tens
