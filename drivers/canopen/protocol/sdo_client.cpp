@@ -7,6 +7,19 @@
 
 namespace rigctl::canopen {
 
+namespace {
+// A frame of this client's channel that is not used (counted by the caller).
+SdoResult dropped(Malformed why, uint16_t index, uint8_t subindex, const char* text) {
+  SdoResult r;
+  r.kind = SdoResult::Kind::kMalformed;
+  r.malformed = why;
+  r.index = index;
+  r.subindex = subindex;
+  r.text = text;
+  return r;
+}
+}  // namespace
+
 uint32_t SdoClient::response_cob_id() const { return kCobSdoTxBase + (node_ & 0x7F); }
 uint32_t SdoClient::request_cob_id() const { return kCobSdoRxBase + (node_ & 0x7F); }
 
@@ -72,21 +85,9 @@ SdoResult SdoClient::on_frame(const CanFrame& frame, int64_t now_ns) {
     r.kind = SdoResult::Kind::kIgnored;
     return r;
   }
-  if (!busy()) {
-    r.kind = SdoResult::Kind::kMalformed;
-    r.malformed = Malformed::kUnexpectedSdo;
-    r.text = "SDO response with no transfer pending";
-    return r;
-  }
+  if (!busy()) return dropped(Malformed::kUnexpectedSdo, 0, 0, "SDO response with no transfer pending");
   if (expired(now_ns)) return poll(now_ns);
-  if (frame.len != 8) {
-    r.kind = SdoResult::Kind::kMalformed;
-    r.malformed = Malformed::kWrongLength;
-    r.index = index_;
-    r.subindex = subindex_;
-    r.text = "SDO frame not 8 bytes";
-    return r;
-  }
+  if (frame.len != 8) return dropped(Malformed::kWrongLength, index_, subindex_, "SDO frame not 8 bytes");
 
   const uint8_t command = frame.data[0];
   if (command == sdo::kAbort) {
@@ -111,13 +112,8 @@ namespace {
 // answer to an earlier request (one that timed out and was sent again) is
 // the usual one. Dropped, the transfer goes on waiting for its own.
 SdoResult stale_answer(uint16_t index, uint8_t subindex) {
-  SdoResult r;
-  r.kind = SdoResult::Kind::kMalformed;
-  r.malformed = Malformed::kUnexpectedSdo;
-  r.index = index;
-  r.subindex = subindex;
-  r.text = "SDO response for another index/subindex (a late answer to an earlier request?)";
-  return r;
+  return dropped(Malformed::kUnexpectedSdo, index, subindex,
+                 "SDO response for another index/subindex (a late answer to an earlier request?)");
 }
 }  // namespace
 
