@@ -365,7 +365,9 @@ TEST(SdoClientProtocol, AnswerForAnotherObjectIsDroppedAndTheTransferGoesOn) {
     EXPECT_TRUE(client.busy()) << c.what;
     const SdoResult own = client.on_frame(c.own, kT0 + 2);
     EXPECT_EQ(own.kind, SdoResult::Kind::kDone) << c.what;
-    if (c.upload) EXPECT_EQ(own.value, 0x1234U) << c.what;
+    if (c.upload) {
+      EXPECT_EQ(own.value, 0x1234U) << c.what;
+    }
   }
 }
 
