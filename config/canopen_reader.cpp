@@ -44,6 +44,24 @@ std::vector<SdoWrite> read_startup_sdo(ConfigReader& parent) {
   return writes;
 }
 
+// The PDOs the client sets up in the valve, and the spool scale.
+void read_pdo_settings(ConfigReader& r, CanopenValveConfig& c) {
+  if (r.has("configure_pdos")) c.configure_pdos = r.boolean("configure_pdos");
+  if (r.has("actual_period_s")) c.actual_period_s = valve_milliseconds(r, "actual_period_s");
+  if (c.actual_period_s >= c.actual_max_age_s) {
+    r.fail(r.has("actual_period_s") ? "actual_period_s" : "actual_max_age_s",
+           "the valve's actual value period must be shorter than actual_max_age_s");
+  }
+  if (r.has("setpoint_timeout_s")) {
+    c.setpoint_timeout_s = r.number("setpoint_timeout_s", 0.0, 65.535);
+    if (c.setpoint_timeout_s != 0.0) {
+      c.setpoint_timeout_s = valve_milliseconds(r, "setpoint_timeout_s");
+      if (c.setpoint_timeout_s < 0.004) r.fail("setpoint_timeout_s", "must be 0 (off) or at least 0.004 s");
+    }
+  }
+  if (r.has("spool_full_scale")) c.spool_full_scale = static_cast<int>(r.integer("spool_full_scale", 1, 32767));
+}
+
 }  // namespace
 
 CanopenValveConfig read_canopen_valve(ConfigReader r) {
@@ -94,11 +112,14 @@ CanopenValveConfig read_canopen_valve(ConfigReader r) {
     }
   }
   if (r.has("reset_on_start")) c.reset_on_start = r.boolean("reset_on_start");
+  if (r.has("boot_timeout_s")) c.boot_timeout_s = r.number("boot_timeout_s", 0.001, 600.0);
 
   c.sdo_timeout_s = r.number("sdo_timeout_s", 0.001, 10.0);
   if (r.has("io_priority")) c.io_priority = static_cast<int>(r.integer("io_priority", 0, 99));
   if (r.has("startup_timeout_s")) c.startup_timeout_s = r.number("startup_timeout_s", 0.01, 600.0);
+  if (r.has("device_state_timeout_s")) c.device_state_timeout_s = r.number("device_state_timeout_s", 0.001, 600.0);
   c.actual_max_age_s = r.number("actual_max_age_s", 1e-6, 10.0);
+  read_pdo_settings(r, c);
 
   c.setpoint_output = r.text("setpoint_output");
   if (c.setpoint_output.empty()) r.fail("setpoint_output", "must name an output channel");

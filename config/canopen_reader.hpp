@@ -14,9 +14,15 @@
 //     valve_heartbeat_period_s: 0.016  # optional (heartbeat_timeout_s / 3): 0x1017, whole ms, < heartbeat_timeout_s
 //     valve_consumer_time_s: 0.05      # optional (2.5 x heartbeat_period_s): 0x1016:1, whole ms, > heartbeat_period_s
 //     reset_on_start: true             # optional (true): NMT reset communication, wait for boot-up
-//     sdo_timeout_s: 0.1
+//     boot_timeout_s: 1.0              # optional (1.0): the boot-up must follow the reset within this
+//     sdo_timeout_s: 0.5               # per request; one that times out is sent once more
 //     startup_timeout_s: 2.0           # optional (2.0): bounds the whole start-up
+//     device_state_timeout_s: 0.5      # optional (0.5): each step of the walk to DEVICE MODE ACTIVE
 //     actual_max_age_s: 0.0075         # older spool actual values are flagged invalid
+//     configure_pdos: true             # optional (true): write the PDOs below into the valve (false: only check them)
+//     actual_period_s: 0.001           # optional (0.001): TPDO event timer, whole ms, < actual_max_age_s
+//     setpoint_timeout_s: 0.05         # optional (0.05): RPDO event timer, the valve's setpoint deadline; 0: off
+//     spool_full_scale: 16384          # optional: counts for 100 %, checked against the valve's 0x6311:1
 //     setpoint_output: u               # output channel written as the spool setpoint
 //     actual_input: x_s                # input channel: spool actual, fraction of rated (-1..1)
 //     pressure_input: p_v              # optional: pressure actual value 0x6381:1 in the TPDO, Pa

@@ -57,8 +57,14 @@ void HardwareDriver::start() {
 bool HardwareDriver::read(Sample& out) {
   const int64_t now = ModbusDaq::now_ns();
   out.status = 0;
+  out.outputs_not_following = 0;
   daq_->read_inputs(out, 0, now);
-  if (valve_) valve_->read_actual(out, daq_inputs_, now);
+  if (valve_) {
+    valve_->read_actual(out, daq_inputs_, now);
+    // Flagged spool actual value: the valve is not (known to be) following
+    // the setpoint (it left DEVICE MODE ACTIVE, or is not heard from).
+    if ((out.status >> daq_inputs_) & 1U) out.outputs_not_following |= 1U << valve_output_;
+  }
   out.t_ns = now - start_ns_;
   // Commands the DAQ could not deliver leave the valve on an old command:
   // as dangerous as stale inputs, so the loop faults.
@@ -78,6 +84,11 @@ void HardwareDriver::make_safe() noexcept {
 void HardwareDriver::stop() {
   if (valve_) valve_->stop();
   daq_->stop();
+}
+
+std::string HardwareDriver::input_fault_cause(std::size_t input) const {
+  if (!valve_ || input < daq_inputs_ || input >= daq_inputs_ + valve_->input_count()) return {};
+  return valve_->flag_cause();
 }
 
 DriverDiagnostics HardwareDriver::diagnostics() {

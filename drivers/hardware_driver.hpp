@@ -28,6 +28,7 @@ class HardwareDriver final : public Driver {
   void make_safe() noexcept override;
   void stop() override;
   DriverDiagnostics diagnostics() override;
+  std::string input_fault_cause(std::size_t input) const override;
   DistributionSummary io_latency() const override { return daq_->io_latency(); }
 
  private:

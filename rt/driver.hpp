@@ -32,7 +32,8 @@ class Driver {
   // Opens devices, connects, primes the plant. Not real-time; may throw.
   virtual void start() = 0;
 
-  // Real-time path: fills `out` with the latest inputs in SI units. Must not
+  // Real-time path: fills `out` with the latest inputs in SI units, their
+  // status bits and the outputs whose actuator is not following. Must not
   // allocate, lock or block beyond the device's own bounded I/O. Returns false
   // when no usable sample could be had this tick.
   virtual bool read(Sample& out) = 0;
@@ -50,6 +51,15 @@ class Driver {
   // Counters and new events. Not real-time; safe to call from another thread
   // while the loop runs.
   virtual DriverDiagnostics diagnostics() { return {}; }
+
+  // Why input `input` was first flagged invalid in this run, in words, where
+  // the driver knows more than the flag (e.g. "canopen valve node 1:
+  // heartbeat lost ..."); empty otherwise. Not real-time; still valid after
+  // stop().
+  virtual std::string input_fault_cause(std::size_t input) const {
+    (void)input;
+    return {};
+  }
 
   // Round-trip time of the driver's I/O cycles, for the run summary; count 0
   // when the driver has no wire (the simulated plant).

@@ -31,6 +31,25 @@ int set_fifo_priority(std::thread& thread, int priority) {
   return pthread_setschedparam(thread.native_handle(), SCHED_FIFO, &param);
 }
 
+ScopedFifoPriority::ScopedFifoPriority(int priority) {
+  if (priority <= 0) return;
+  sched_param old{};
+  error_ = pthread_getschedparam(pthread_self(), &old_policy_, &old);
+  if (error_ != 0) return;
+  old_priority_ = old.sched_priority;
+  sched_param param{};
+  param.sched_priority = priority;
+  error_ = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param);
+  changed_ = error_ == 0;
+}
+
+ScopedFifoPriority::~ScopedFifoPriority() {
+  if (!changed_) return;
+  sched_param old{};
+  old.sched_priority = old_priority_;
+  pthread_setschedparam(pthread_self(), old_policy_, &old);
+}
+
 RealtimeSession::RealtimeSession(const RealtimeConfig& config) {
   if (!config.enabled) {
     warnings_.push_back("real-time set-up disabled in config: running best effort");

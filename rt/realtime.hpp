@@ -23,6 +23,25 @@ struct RealtimeConfig {
 // the thread runs best effort.
 int set_fifo_priority(std::thread& thread, int priority);
 
+// Gives the calling thread SCHED_FIFO at `priority` for a while (a start-up
+// that must keep a deadline, e.g. a heartbeat a device watches), and its
+// old policy back when destroyed. error() is 0 or the error number of a
+// refusal (the thread then runs best effort); priority 0 changes nothing.
+class ScopedFifoPriority {
+ public:
+  explicit ScopedFifoPriority(int priority);
+  ~ScopedFifoPriority();
+  ScopedFifoPriority(const ScopedFifoPriority&) = delete;
+  ScopedFifoPriority& operator=(const ScopedFifoPriority&) = delete;
+  int error() const { return error_; }
+
+ private:
+  bool changed_ = false;
+  int error_ = 0;
+  int old_policy_ = 0;
+  int old_priority_ = 0;
+};
+
 // Holds what was acquired (the cpu_dma_latency file) until destroyed.
 class RealtimeSession {
  public:

@@ -33,6 +33,11 @@ struct ChannelLayout {
 struct Sample {
   int64_t t_ns = 0;     // rig time of acquisition: simulated time, or monotonic time since start
   uint32_t status = 0;  // bit i set: input i is invalid (stale, out of range, not a number)
+  // Bit j set: output j's actuator does not follow its command now (e.g. a
+  // fieldbus valve outside its active state). What is sent still goes out
+  // and is recorded, but a controller must not integrate an error the
+  // output cannot act on.
+  uint32_t outputs_not_following = 0;
   std::array<double, kMaxInputs> value{};
 };
 

@@ -74,9 +74,13 @@ int main(int argc, char** argv) {
   auto* modbus_opt = sim_cmd->add_option("--modbus", sim.modbus_tcp, "Serve Modbus TCP on HOST:PORT (port 0: any free port)");
   sim_cmd->add_option("--modbus-rtu", sim.modbus_rtu, "Serve Modbus RTU on this serial device")->excludes(modbus_opt);
   sim_cmd->add_option("--can-socket", sim.can_socket, "Serve the CANopen valve on this seqpacket socket path");
+  sim_cmd->add_option("--valve", sim.valve_options,
+                      "A behaviour of the simulated CANopen valve, KEY[=VALUE]: device_type=401, spool_reference=N, "
+                      "boot_delay=S, power_on_mapping=profile|minimal, fixed_mapping, segmented_uploads, "
+                      "stall=init|disabled|hold; repeatable");
   auto* sim_duration_opt = sim_cmd->add_option("--duration", sim_duration, "Stop after this many seconds (default: at SIGINT/SIGTERM)")->check(CLI::PositiveNumber);
   sim_cmd->add_option("--output-watchdog", sim.output_watchdog_s, "DAQ output watchdog [s]: no write for this long and the outputs go to their safe values; 0: off")->capture_default_str();
-  sim_cmd->add_option("--fault", fault_texts, "Inject a fault, KIND@TIME[:ARG...] (silence, drop, late, exception, stuck, rail, heartbeat, emcy); repeatable");
+  sim_cmd->add_option("--fault", fault_texts, "Inject a fault, KIND@TIME[:ARG...] (silence, drop, late, exception, stuck, rail, heartbeat, emcy, hold); repeatable");
 
   rigctl::CompareOptions compare;
   auto* compare_cmd = app.add_subcommand("compare", "Half car: passive, fuzzy, skyhook and LQR on the configured road, metrics beside the paper's");

@@ -21,6 +21,24 @@ inline std::string od_address(uint16_t index, uint8_t subindex) {
   return buffer;
 }
 
+// The bits of an error register (0x1001) in words, "no error" for 0.
+inline std::string error_register_text(uint8_t r) {
+  static constexpr const char* kBits[8] = {"generic", "current", "voltage", "temperature",
+                                           "communication", "device profile", "reserved", "manufacturer"};
+  std::string s;
+  for (int i = 0; i < 8; ++i) {
+    if (r & (1U << i)) s += (s.empty() ? "" : ", ") + std::string(kBits[i]);
+  }
+  return s.empty() ? "no error" : s;
+}
+
+// "0.5 s" style, for times given in the config.
+inline std::string seconds(double s) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%g s", s);
+  return buffer;
+}
+
 inline std::string milliseconds(int64_t ns) {
   char buffer[32];
   std::snprintf(buffer, sizeof buffer, "%.1f ms", static_cast<double>(ns) / 1e6);

@@ -37,17 +37,29 @@ struct CanopenValveConfig {
   double valve_consumer_time_s = 0.05;
 
   bool reset_on_start = true;   // NMT reset communication and wait for the boot-up first
-  double sdo_timeout_s = 0.1;
-  int io_priority = 0;  // SCHED_FIFO priority of the I/O thread (0: normal scheduling)
-  double startup_timeout_s = 2.0;  // bounds the whole of start(): connect, boot-up, SDO, operational
+  double boot_timeout_s = 1.0;  // the boot-up must follow the reset within this (and the start-up timeout)
+  double sdo_timeout_s = 0.5;   // per SDO request; one that times out is sent once more
+  // SCHED_FIFO priority of the I/O thread, and of the start-up thread while
+  // it produces our heartbeat (0: normal scheduling).
+  int io_priority = 0;
+  double startup_timeout_s = 2.0;  // bounds the whole of start(): connect, boot-up, SDO, operational, ACTIVE
+  double device_state_timeout_s = 0.5;  // each step of the walk to DEVICE MODE ACTIVE must be taken within this
   std::vector<SdoWrite> startup_sdo;
 
   // PDOs (CiA 408 default p/Q mapping, drivers/canopen/protocol/cia408.hpp):
   // RPDO n: control word, spool setpoint; TPDO n: status word, spool actual
-  // value [, pressure actual value]; spool 16384 counts = 100 %.
+  // value [, pressure actual value]. Written into the valve at start-up with
+  // the CiA 301 sequence (configure_pdos) and always read back and checked.
   int setpoint_rpdo = 1;
   int actual_tpdo = 1;
+  bool configure_pdos = true;        // false: the valve's PDOs are only read back and checked
+  double actual_period_s = 0.001;    // TPDO event timer: the valve sends its actual value this often (whole ms)
+  double setpoint_timeout_s = 0.05;  // RPDO event timer: no setpoint for this long and the valve faults to its safe state (whole ms; 0: off)
   double actual_max_age_s = 0.0075;  // an older spool actual value is flagged invalid
+  // Counts of the spool setpoint/actual value that mean 100 %: 0 takes the
+  // valve's reference value 0x6311:1; another value is checked against it
+  // (and used where the valve has no such object).
+  int spool_full_scale = 0;
 
   std::string setpoint_output = "u";  // output channel the composing driver feeds to write_setpoint()
   std::string actual_input = "x_s";   // spool actual, fraction of rated opening, -1..1

@@ -16,6 +16,7 @@
 namespace rigctl {
 
 using namespace canopen;
+using canopen_text::error_register_text;
 using canopen_text::hex;
 using canopen_text::milliseconds;
 using canopen_text::od_address;
@@ -29,16 +30,6 @@ std::string frame_text(const CanFrame& f) {
   return s;
 }
 
-std::string error_register_text(uint8_t r) {
-  static constexpr const char* kBits[8] = {"generic", "current", "voltage", "temperature",
-                                           "communication", "device profile", "reserved", "manufacturer"};
-  std::string s;
-  for (int i = 0; i < 8; ++i) {
-    if (r & (1U << i)) s += (s.empty() ? "" : ", ") + std::string(kBits[i]);
-  }
-  return s.empty() ? "no error" : s;
-}
-
 }  // namespace
 
 void CanopenValve::io_loop() {
@@ -48,11 +39,23 @@ void CanopenValve::io_loop() {
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
       continue;
     }
-    // Wake for our next heartbeat, and at least every 5 ms to poll the
-    // consumer timeout and the stop request.
-    const int64_t until_heartbeat_ms = (producer_.next_due_ns() - clock_ns()) / 1'000'000;
-    service(static_cast<int>(std::clamp<int64_t>(until_heartbeat_ms, 0, 5)));
+    // Wake for our next heartbeat or null setpoint, and at least every 5 ms
+    // to poll the consumer timeout and the stop request.
+    const int64_t next = std::min(producer_.next_due_ns(), next_keepalive_ns_);
+    service(static_cast<int>(std::clamp<int64_t>((next - clock_ns()) / 1'000'000, 0, 5)));
+    repeat_null_setpoint(clock_ns());
   }
+}
+
+// While the loop holds the valve safe it writes nothing; the valve's RPDO
+// deadline must not expire then. A loop that stalls while driving gets no
+// help here: its last setpoint lapses at the deadline, as it should.
+void CanopenValve::repeat_null_setpoint(int64_t now_ns) {
+  if (now_ns < next_keepalive_ns_) return;
+  next_keepalive_ns_ = now_ns + keepalive_ns_;
+  if (!running_.load(std::memory_order_acquire) || !safe_hold_.load(std::memory_order_acquire)) return;
+  send_rpdo(cia408::kControlActive, 0.0);
+  counters_.keepalives.fetch_add(1, std::memory_order_relaxed);
 }
 
 void CanopenValve::service(int timeout_ms) {
@@ -178,12 +181,26 @@ void CanopenValve::on_actual(const CanFrame& f, int64_t now_ns) {
   a.pressure = tpdo_map_.size() > 2 ? v[2] : 0.0;
   latest_.store(a);
 
-  const auto state = cia408::valve_state(a.status_word);
-  if (a.count == 1 || state != cia408::valve_state(last_status_word_)) {
-    events_.push(prefix() + "valve device state " + cia408::valve_state_name(state) + " (status word " +
-                 hex(a.status_word, 4) + ")" + ((a.status_word & cia408::kBitReady) ? "" : ": not ready, inputs flagged invalid"));
+  on_device_state(a.status_word);
+}
+
+// Any departure from DEVICE MODE ACTIVE once running is latched: the valve
+// stopped following the setpoint, and one that comes back must not take up
+// whatever the loop would have sent meanwhile.
+void CanopenValve::on_device_state(uint16_t status_word) {
+  const auto state = cia408::valve_state(status_word);
+  const bool changed = actual_count_ == 1 || state != cia408::valve_state(last_status_word_);
+  last_status_word_ = status_word;
+  if (!changed) return;
+  std::string msg = prefix() + "valve device state " + cia408::valve_state_name(state) + " (status word " +
+                    hex(status_word, 4) + ")";
+  if (expect_operational_ && state != cia408::ValveState::kActive && (faults() & kFaultDeviceState) == 0) {
+    left_active_status_word_.store(status_word, std::memory_order_release);
+    set_fault(kFaultDeviceState);
+    counters_.left_active.fetch_add(1, std::memory_order_relaxed);
+    msg += ": left DEVICE MODE ACTIVE, inputs flagged invalid until restart";
   }
-  last_status_word_ = a.status_word;
+  events_.push(std::move(msg));
 }
 
 void CanopenValve::on_heartbeat(const Heartbeat& hb, int64_t now_ns) {
@@ -226,6 +243,8 @@ void CanopenValve::on_emcy(const Emcy& e) {
   // bit set means the valve is in error, 0 means it has recovered.
   const bool active = e.error_register != 0;
   if (active) {
+    last_emcy_code_.store(e.error_code, std::memory_order_release);
+    last_emcy_register_.store(e.error_register, std::memory_order_release);
     set_fault(kFaultEmcy);
   } else {
     clear_fault(kFaultEmcy);
@@ -242,7 +261,10 @@ void CanopenValve::on_sdo(const CanFrame& f, int64_t now_ns) {
   switch (r.kind) {
     case SdoResult::Kind::kMalformed: count_malformed(r.malformed, f); return;
     case SdoResult::Kind::kIgnored: counters_.ignored.fetch_add(1, std::memory_order_relaxed); return;
-    case SdoResult::Kind::kPending: return;
+    case SdoResult::Kind::kPending:  // a segment of a segmented upload: ask for the next
+      counters_.accepted.fetch_add(1, std::memory_order_relaxed);
+      if (r.to_send) send(*r.to_send);
+      return;
     default:
       counters_.accepted.fetch_add(1, std::memory_order_relaxed);
       if (r.to_send) send(*r.to_send);

@@ -1,7 +1,8 @@
 // CanopenValve start-up: open the transport, reset communication, configure
-// by SDO, NMT start, wait for operational. Runs on the caller's thread before
-// the I/O thread exists, pumping frames itself, so every step is a plain
-// sequential wait with one overall deadline.
+// by SDO, NMT start, wait for operational, walk the device state machine to
+// DEVICE MODE ACTIVE. Runs on the caller's thread before the I/O thread
+// exists, pumping frames itself, so every step is a plain sequential wait
+// with one overall deadline.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -9,9 +10,9 @@
 #include <stdexcept>
 #include <thread>
 
-#include "drivers/canopen/protocol/cob_id.hpp"
 #include "drivers/canopen/canopen_text.hpp"
 #include "drivers/canopen/canopen_valve.hpp"
+#include "drivers/canopen/protocol/cob_id.hpp"
 #include "drivers/canopen/socketcan.hpp"
 
 namespace rigctl {
@@ -19,23 +20,11 @@ namespace rigctl {
 using namespace canopen;
 using canopen_text::hex;
 using canopen_text::milliseconds;
-using canopen_text::od_address;
+using canopen_text::seconds;
 
 namespace {
-
 uint32_t whole_ms(double s) { return static_cast<uint32_t>(std::lround(s * 1000.0)); }
-
-std::string seconds(double s) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%g s", s);
-  return b;
-}
-
-std::string describe(const SdoWrite& w) {
-  return "'" + w.name + "' " + od_address(w.index, w.subindex) + " = " + hex(w.value, 2 * w.size) + " (" +
-         std::to_string(w.size) + (w.size == 1 ? " byte)" : " bytes)");
-}
-
+int64_t to_ns(double s) { return static_cast<int64_t>(std::llround(s * 1e9)); }
 }  // namespace
 
 void CanopenValve::fail(const std::string& what) const { throw std::runtime_error(prefix() + what); }
@@ -65,13 +54,14 @@ CanTransport CanopenValve::open_transport(int64_t deadline_ns) {
   }
 }
 
-template <typename Pred>
-void CanopenValve::pump_until(Pred done, int64_t deadline_ns, const std::string& what) {
+void CanopenValve::pump_until(const std::function<bool()>& done, int64_t deadline_ns, const std::string& what,
+                              const std::string& limit) {
   while (!done()) {
     if (link_lost_) fail("connection lost (" + transport_.name() + ") while waiting for " + what);
     const int64_t now = clock_ns();
     if (now >= deadline_ns) {
-      fail("no " + what + " within the start-up timeout of " + seconds(config_.startup_timeout_s));
+      fail("no " + what + " within " +
+           (limit.empty() ? "the start-up timeout of " + seconds(config_.startup_timeout_s) : limit));
     }
     const int64_t left_ms = (deadline_ns - now) / 1'000'000 + 1;
     service(static_cast<int>(std::clamp<int64_t>(left_ms, 1, 5)));
@@ -84,17 +74,7 @@ void CanopenValve::run_startup(int64_t deadline_ns) {
   producer_.start(clock_ns());
   housekeeping(clock_ns());
 
-  if (config_.reset_on_start) {
-    // Known communication state (pre-operational, PDO and heartbeat objects
-    // from the valve's stored values) whatever the previous session left.
-    const uint32_t boot_ups = consumer_.boot_ups();
-    if (!send(encode_nmt(NmtCommand::kResetCommunication, config_.node_id))) {
-      fail("cannot send NMT reset communication: " + std::string(std::strerror(transport_.last_errno())));
-    }
-    pump_until([&] { return consumer_.boot_ups() > boot_ups; }, deadline_ns,
-               "boot-up message after NMT reset communication");
-  }
-
+  if (config_.reset_on_start) reset_communication(deadline_ns);
   read_identity(deadline_ns);
   if (config_.configure_heartbeats) {
     sdo_write({"valve heartbeat producer time (ms)", 0x1017, 0, 2, whole_ms(config_.valve_heartbeat_period_s)},
@@ -104,8 +84,42 @@ void CanopenValve::run_startup(int64_t deadline_ns) {
                                         static_cast<uint16_t>(whole_ms(config_.valve_consumer_time_s)))},
               deadline_ns);
   }
+  configure_pdos(deadline_ns);
+  read_spool_scale(deadline_ns);
   for (const SdoWrite& w : config_.startup_sdo) sdo_write(w, deadline_ns);
+  start_operational(deadline_ns);
+  walk_to_active(deadline_ns);
+}
 
+// Known communication state (pre-operational, PDO and heartbeat objects
+// from the valve's stored values) whatever the previous session left. What
+// arrived before the reset cannot answer it: a boot-up already queued (the
+// valve's power-on, or one from before we connected) is discarded, and only
+// a boot-up received after the reset went out counts.
+void CanopenValve::reset_communication(int64_t deadline_ns) {
+  uint64_t discarded = 0;
+  CanFrame stale;
+  for (CanTransport::Rx rx; (rx = transport_.receive(stale, 0)) != CanTransport::Rx::kTimeout;) {
+    if (rx == CanTransport::Rx::kHangUp || rx == CanTransport::Rx::kError) {
+      on_link_lost(rx);
+      break;
+    }
+    ++discarded;
+  }
+  counters_.discarded_before_reset.fetch_add(discarded, std::memory_order_relaxed);
+  const uint32_t boot_ups = consumer_.boot_ups();
+  const int64_t sent_ns = clock_ns();
+  if (!send(encode_nmt(NmtCommand::kResetCommunication, config_.node_id))) {
+    fail("cannot send NMT reset communication: " + std::string(std::strerror(transport_.last_errno())));
+  }
+  pump_until([&] { return consumer_.boot_ups() > boot_ups; }, std::min(deadline_ns, sent_ns + to_ns(config_.boot_timeout_s)),
+             "boot-up message after NMT reset communication",
+             "boot_timeout_s = " + seconds(config_.boot_timeout_s));
+  events_.push(prefix() + "boot-up " + milliseconds(consumer_.last_heartbeat_ns() - sent_ns) +
+               " after NMT reset communication (" + std::to_string(discarded) + " frame(s) queued before it discarded)");
+}
+
+void CanopenValve::start_operational(int64_t deadline_ns) {
   if (!send(encode_nmt(NmtCommand::kStart, config_.node_id))) {
     fail("cannot send NMT start: " + std::string(std::strerror(transport_.last_errno())));
   }
@@ -124,68 +138,6 @@ void CanopenValve::run_startup(int64_t deadline_ns) {
              "spool actual value (TPDO" + std::to_string(config_.actual_tpdo) + ", COB-ID " + hex(actual_cob_, 3) +
                  ") after NMT start; check the valve's TPDO transmission type and event timer (" +
                  hex(static_cast<uint32_t>(0x1800 + config_.actual_tpdo - 1), 4) + " sub 2 and 5)");
-}
-
-canopen::SdoResult CanopenValve::sdo_transfer(const std::optional<CanFrame>& request, const std::string& what,
-                                              int64_t deadline_ns) {
-  sdo_result_.reset();
-  if (!request) fail(what + ": SDO client busy");
-  if (!send(*request)) {
-    sdo_.cancel();
-    fail(what + ": cannot send: " + std::strerror(transport_.last_errno()));
-  }
-  pump_until([&] { return sdo_result_.has_value(); }, deadline_ns, "SDO response to the " + what);
-  const SdoResult r = *sdo_result_;
-  sdo_result_.reset();
-  if (r.kind != SdoResult::Kind::kDone) counters_.sdo_aborts.fetch_add(1, std::memory_order_relaxed);
-  return r;
-}
-
-namespace {
-std::string failure_text(const SdoResult& r, double sdo_timeout_s) {
-  if (r.kind != SdoResult::Kind::kAbort) return " failed: " + std::string(r.text);
-  std::string msg = " aborted with " + hex(r.abort_code, 8) + ": " + r.text;
-  if (r.abort_code == sdo::kAbortTimeout) msg += " (no answer within sdo_timeout_s = " + seconds(sdo_timeout_s) + ")";
-  return msg;
-}
-}  // namespace
-
-void CanopenValve::sdo_write(const SdoWrite& w, int64_t deadline_ns) {
-  const std::string what = "start-up SDO write " + describe(w);
-  const SdoResult r = sdo_transfer(sdo_.start_download(w.index, w.subindex, w.value, w.size, clock_ns()), what, deadline_ns);
-  if (r.kind == SdoResult::Kind::kDone) return;
-  const std::string msg = what + failure_text(r, config_.sdo_timeout_s);
-  events_.push(prefix() + msg);
-  fail(msg);
-}
-
-std::optional<uint32_t> CanopenValve::sdo_read(uint16_t index, uint8_t subindex, const std::string& what, bool required,
-                                               int64_t deadline_ns) {
-  const std::string full = "start-up SDO read of the " + what + " " + od_address(index, subindex);
-  const SdoResult r = sdo_transfer(sdo_.start_upload(index, subindex, clock_ns()), full, deadline_ns);
-  if (r.kind == SdoResult::Kind::kDone) return r.value;
-  const std::string msg = full + failure_text(r, config_.sdo_timeout_s);
-  events_.push(prefix() + msg + (required ? "" : " (optional object: ignored)"));
-  if (required) fail(msg);
-  return std::nullopt;
-}
-
-void CanopenValve::read_identity(int64_t deadline_ns) {
-  ValveIdentity id;
-  id.device_type = *sdo_read(0x1000, 0, "device type", true, deadline_ns);
-  id.vendor_id = *sdo_read(0x1018, 1, "vendor id", true, deadline_ns);
-  id.product_code = sdo_read(0x1018, 2, "product code", false, deadline_ns);
-  id.revision = sdo_read(0x1018, 3, "revision number", false, deadline_ns);
-  id.serial = sdo_read(0x1018, 4, "serial number", false, deadline_ns);
-  auto opt = [](const std::optional<uint32_t>& v) { return v ? hex(*v, 8) : std::string("n/a"); };
-  events_.push(prefix() + "identity: device type " + hex(id.device_type, 8) + ", vendor " + hex(id.vendor_id, 8) +
-               ", product " + opt(id.product_code) + ", revision " + opt(id.revision) + ", serial " + opt(id.serial));
-  // Not fatal: some valves report a manufacturer-specific device type.
-  if ((id.device_type & 0xFFFF) != 408) {
-    events_.push(prefix() + "warning: device type " + hex(id.device_type, 8) + " does not name the CiA 408 profile");
-  }
-  std::lock_guard<std::mutex> lock(admin_mutex_);
-  identity_ = id;
 }
 
 }  // namespace rigctl

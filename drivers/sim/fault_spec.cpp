@@ -54,7 +54,8 @@ int integer(const std::string& spec, const std::string& text, const char* what) 
 bool fault_on_wire(FaultKind kind) {
   switch (kind) {
     case FaultKind::kSilence: case FaultKind::kDrop: case FaultKind::kLate: case FaultKind::kException:
-    case FaultKind::kStuck: case FaultKind::kRail: case FaultKind::kHeartbeat: case FaultKind::kEmcy: return true;
+    case FaultKind::kStuck: case FaultKind::kRail: case FaultKind::kHeartbeat: case FaultKind::kEmcy:
+    case FaultKind::kHold: return true;
     default: return false;
   }
 }
@@ -104,6 +105,10 @@ FaultSpec parse_fault_spec(const std::string& spec) {
     f.kind = FaultKind::kHeartbeat;
     need(1, 1, "heartbeat@TIME:DURATION");
     f.duration_s = seconds(spec, args[1], "duration");
+  } else if (kind == "hold") {
+    f.kind = FaultKind::kHold;
+    need(1, 1, "hold@TIME:DURATION");
+    f.duration_s = seconds(spec, args[1], "duration");
   } else if (kind == "emcy") {
     f.kind = FaultKind::kEmcy;
     need(2, 2, "emcy@TIME:CODE:ERROR_REGISTER");
@@ -146,7 +151,7 @@ FaultSpec parse_fault_spec(const std::string& spec) {
     f.value = args.size() > 2 ? number(spec, args[2], "orifice coefficient", 0.0) : 1e-6;
   } else {
     bad(spec, "unknown kind '" + kind +
-                  "' (silence, drop, late, exception, stuck, rail, heartbeat, emcy, noise, nan, offset, overrun, "
+                  "' (silence, drop, late, exception, stuck, rail, heartbeat, emcy, hold, noise, nan, offset, overrun, "
                   "supply, burst)");
   }
   if (f.channel.empty() && (f.kind == FaultKind::kException || f.kind == FaultKind::kStuck || f.kind == FaultKind::kRail ||

@@ -8,6 +8,7 @@
 //   rail@5:p1          force p1's register to the top of its range (open circuit)
 //   heartbeat@5:0.5    the CANopen valve misses its heartbeats for 0.5 s
 //   emcy@5:0x5000:1    the valve sends an EMCY, code 0x5000, error register 1
+//   hold@5:0.5         the valve drops from DEVICE MODE ACTIVE to HOLD for 0.5 s
 // Times are seconds since rig-sim started.
 //
 // The same syntax injects faults into the simulated driver of `rigctl run`
@@ -30,7 +31,7 @@ namespace rigctl {
 
 enum class FaultKind {
   // On the wire (rig-sim); stuck and rail also in the simulated driver.
-  kSilence, kDrop, kLate, kException, kStuck, kRail, kHeartbeat, kEmcy,
+  kSilence, kDrop, kLate, kException, kStuck, kRail, kHeartbeat, kEmcy, kHold,
   // In the simulated driver of `rigctl run` only.
   kNoise, kNan, kOffset, kOverrun, kSupply, kBurst
 };
@@ -42,7 +43,7 @@ bool fault_in_process(FaultKind kind);   // `rigctl run` with the simulated driv
 struct FaultSpec {
   FaultKind kind = FaultKind::kDrop;
   double at_s = 0.0;
-  double duration_s = 0.0;  // silence, late, heartbeat, noise, nan; 0 = until the end
+  double duration_s = 0.0;  // silence, late, heartbeat, hold, noise, nan; 0 = until the end
   double delay_s = 0.0;     // late
   std::string channel;      // exception, stuck, rail, noise, nan, offset; burst: p1 or p2
   double value = 0.0;       // noise SD, offset [channel SI]; supply pressure [Pa]; burst K [m^3/s/sqrt(Pa)]

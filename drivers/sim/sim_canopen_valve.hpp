@@ -1,34 +1,45 @@
 // A simulated CiA 408 servovalve node: the far side of CanopenValve, for the
-// simulated rig (rig-sim) and the tests. It serves the object dictionary
-// subset the client configures, runs the NMT state machine (boot-up,
-// pre-operational, operational, stopped, resets), produces its heartbeat,
-// consumes the master's heartbeat and goes to its fail-safe when it is lost,
-// moves the spool as a first-order lag toward the setpoint and sends the
-// spool actual value by TPDO. Faults can be injected from any thread.
+// simulated rig (rig-sim) and the tests. It serves an object dictionary,
+// runs the NMT state machine (initialisation, boot-up, pre-operational,
+// operational, stopped, resets) and the CiA 408 device state machine,
+// produces its heartbeat, consumes the master's and goes to its fail-safe
+// when it is lost, takes its PDO mapping from the dictionary, moves the
+// spool as a first-order lag toward the setpoint and sends the spool actual
+// value by TPDO. Faults can be injected from any thread; the behaviours of
+// real valves a client must cope with are options
+// (sim_canopen_valve_config.hpp).
 //
 // Behaviour, in the terms of CiA 301/408:
-//  * The spool follows the RPDO setpoint only while NMT operational, device
-//    mode 0x6042 = 1 (setpoint via bus; the default is 0, so the client's
-//    start-up SDO writes matter), control word MHD = 111 (ACTIVE) and no
-//    device fault. Otherwise its target is null (0).
-//  * TPDO: the spool actual value (status word, spool actual [, pressure]) is
-//    sent every tpdo_period_s while operational (transmission type 255 with
-//    an event timer; SYNC is not implemented: the loop's period and the
-//    valve's cycle stay independent and the client bounds the age of what it
-//    uses). Writing the event timer 0x1800+n-1 sub 5 (ms, > 0) changes the
-//    period; the other PDO communication objects are stored only.
+//  * Initialisation: after power-on (a new connection) and each NMT reset
+//    the node is silent for boot_delay_s and ignores what it receives
+//    (counted), then sends its boot-up message and enters pre-operational.
+//  * Device state machine (sim_valve_device_state.hpp): from INIT the
+//    control word (by SDO 0x6040 or in the RPDO) walks it to DEVICE MODE
+//    ACTIVE, or as far as the stall option lets it. The spool follows the
+//    RPDO setpoint only while NMT operational, device mode 0x6042 = 1
+//    (setpoint via bus; the default is 0, so the client's start-up writes
+//    matter) and ACTIVE; in HOLD and FAULT_HOLD it goes to the hold setpoint
+//    0x6314:1 (0), otherwise to its fail-safe null.
+//  * PDOs: the mapping is the dictionary's (0x1600/0x1A00 + n - 1; at
+//    power-on the profile's or a minimal one), changed by the CiA 301 rules
+//    (sim_valve_dictionary.hpp) and used from when the PDO is valid. The
+//    TPDO is sent every event timer 0x1800+n-1:5 ms while operational
+//    (SYNC is not implemented: the loop's period and the valve's cycle stay
+//    independent and the client bounds the age of what it uses). An RPDO
+//    whose length differs from the mapping raises EMCY 0x8210 (too short) or
+//    0x8220 (too long). The RPDO event timer 0x1400+n-1:5 (ms, > 0) is a
+//    deadline: with none received in time after the first, EMCY 0x8250, the
+//    DSM faults and the spool goes to null.
 //  * Heartbeat: produced every 0x1017 ms (0: off). Master heartbeat consumer
 //    0x1016:1 (node << 16 | ms); monitoring starts with the first master
-//    heartbeat. When it times out: spool target null, device state
-//    FAULT_HOLD (status word 0x0003: ready bit clear), error register 0x11,
-//    EMCY 0x8130 and NMT pre-operational (the CiA 301 default error
-//    behaviour). The fault clears on a rising edge of control word bit 3
-//    (fault reset), an NMT reset or a new connection.
+//    heartbeat. When it times out: the DSM faults (FAULT_HOLD, ready bit
+//    clear), error register 0x11, EMCY 0x8130 and NMT pre-operational (the
+//    CiA 301 default error behaviour). A fault clears on a rising edge of
+//    control word bit 3 (fault reset), an NMT reset or a new connection.
 //  * NMT reset communication restores 0x1000-0x1FFF, reset node the whole
-//    dictionary; both send the boot-up message and enter pre-operational.
-//  * Listening on a socket path, each accepted connection is a power-on
-//    (dictionary defaults, boot-up); after a disconnect the next connection
-//    is served.
+//    dictionary and the device state machine.
+//  * Listening on a socket path, each accepted connection is a power-on;
+//    after a disconnect the next connection is served.
 #pragma once
 
 #include <atomic>
@@ -45,23 +56,11 @@
 #include "drivers/canopen/protocol/nmt.hpp"
 #include "drivers/canopen/protocol/pdo.hpp"
 #include "drivers/canopen/protocol/sdo.hpp"
+#include "drivers/sim/sim_canopen_valve_config.hpp"
+#include "drivers/sim/sim_valve_device_state.hpp"
+#include "drivers/sim/sim_valve_dictionary.hpp"
 
 namespace rigctl {
-
-struct SimCanopenValveConfig {
-  uint8_t node_id = 1;
-  double spool_time_constant_s = 0.004;  // first-order lag of the spool
-  double tpdo_period_s = 0.001;          // spool actual value sent this often while operational (until 0x1800:5 is written)
-  int setpoint_rpdo = 1;
-  int actual_tpdo = 1;
-  bool with_pressure = false;            // TPDO carries the pressure actual value 0x6381:1
-  double pressure_scale_pa = 1.0;        // Pa per count
-  uint16_t heartbeat_period_ms = 0;      // 0x1017 at power-on (0: off until configured)
-  uint32_t vendor_id = 0x0000'0000;      // 0x1018 identity (simulated)
-  uint32_t product_code = 0x0000'0408;
-  uint32_t revision = 0x0001'0000;
-  uint32_t serial = 1;
-};
 
 class SimCanopenValve {
  public:
@@ -82,6 +81,7 @@ class SimCanopenValve {
   canopen::NmtState nmt_state() const noexcept {
     return static_cast<canopen::NmtState>(nmt_.load(std::memory_order_acquire));
   }
+  canopen::cia408::ValveState device_state() const;
   bool connected() const noexcept { return connected_.load(std::memory_order_acquire); }
   bool fail_safe() const noexcept { return fault_.load(std::memory_order_acquire); }
   // Value of an object dictionary entry (nullopt if the dictionary lacks it).
@@ -94,6 +94,10 @@ class SimCanopenValve {
     uint64_t nmt_commands = 0;
     uint64_t master_heartbeat_losses = 0;
     uint64_t malformed = 0;       // frames received and dropped
+    uint64_t boot_ups = 0;        // boot-up messages sent
+    uint64_t sdo_while_booting = 0;  // SDO requests received while initialising (ignored: a real node is deaf then)
+    uint64_t rpdo_timeouts = 0;
+    uint64_t pdo_length_errors = 0;
   };
   Stats stats() const;
   // Time (CLOCK_MONOTONIC ns) of the last master heartbeat and of the last
@@ -110,6 +114,9 @@ class SimCanopenValve {
   void send_raw(const canopen::CanFrame& frame);       // any frame, e.g. malformed ones
   void send_raw_record(std::vector<uint8_t> bytes);    // a record that is not 16 bytes
   void reset_node();                      // the valve resets itself (boot-up, pre-operational)
+  void drop_to_hold(double duration_s);   // an internal event holds an ACTIVE valve in HOLD for a while
+  void lose_sdo_answers(int count);       // the next `count` SDO answers are lost on the way
+  void fault_device(uint16_t emcy_code);  // a device fault: FAULT_DISABLED/FAULT_HOLD, EMCY, until a fault reset
 
  private:
   struct Outgoing {
@@ -119,29 +126,30 @@ class SimCanopenValve {
   };
 
   void run();
-  void serve(int64_t now);
+  void serve_frames();
   void power_on(int64_t now);
   void reset_communication(int64_t now, bool whole_dictionary);
+  void finish_boot(int64_t now);
   void handle(const canopen::CanFrame& f, int64_t now);
   void handle_nmt(const canopen::CanFrame& f, int64_t now);
-  void handle_rpdo(const canopen::CanFrame& f);
+  void handle_rpdo(const canopen::CanFrame& f, int64_t now);
   void handle_sdo(const canopen::CanFrame& f, int64_t now);
   void after_write(uint16_t index, uint8_t subindex, int64_t now);
-  void apply_control_word(uint16_t cw);
+  void apply_control_word(uint16_t cw, int64_t now);
+  void refresh_pdos();
   void step(int64_t now);
-  void enter_fail_safe(int64_t now);
+  void watch_deadlines(int64_t now);
+  void send_tpdo(int64_t now);
+  void enter_fail_safe(int64_t now, uint16_t emcy_code);
   void queue(const canopen::CanFrame& f, int64_t now);
   void flush(int64_t now);
   int wait_ms(int64_t now) const;
   void set_nmt(canopen::NmtState s) { nmt_state_ = s; nmt_.store(static_cast<uint8_t>(s), std::memory_order_release); }
+  bool booting(int64_t now) const { return boot_until_ns_ != 0 && now < boot_until_ns_; }
   canopen::OdEntry& od(uint16_t index, uint8_t subindex);
-  uint16_t status_word() const;
+  double spool_scale() const { return 1.0 / config_.spool_reference; }
 
   const SimCanopenValveConfig config_;
-  canopen::PdoMapping rpdo_map_;
-  canopen::PdoMapping tpdo_map_;
-  uint32_t setpoint_cob_ = 0;
-  uint32_t actual_cob_ = 0;
 
   std::unique_ptr<SeqpacketListener> listener_;
   std::thread thread_;
@@ -154,21 +162,26 @@ class SimCanopenValve {
   std::vector<canopen::OdEntry> od_;
   std::vector<canopen::OdEntry> od_defaults_;
   std::unique_ptr<canopen::SdoServer> sdo_;
+  SimPdo rpdo_;
+  SimPdo tpdo_;
+  SimValveDeviceState dsm_;
   canopen::NmtState nmt_state_ = canopen::NmtState::kBootUp;
   canopen::HeartbeatProducer producer_{0, 0};
   canopen::HeartbeatConsumer consumer_{0, 0};
   std::deque<Outgoing> out_;
   double setpoint_ = 0.0;        // fraction, from RPDO/SDO
   double spool_state_ = 0.0;
-  uint16_t control_word_ = 0x0001;
+  int64_t boot_until_ns_ = 0;    // initialising until then (0: not booting)
   int64_t last_step_ns_ = 0;
   int64_t next_tpdo_ns_ = 0;
   int64_t tpdo_period_ns_ = 0;
+  int64_t rpdo_deadline_ns_ = 0;  // 0: not monitored (no RPDO yet, or no event timer)
   int64_t miss_heartbeats_until_ns_ = 0;
   int64_t delay_ns_ = 0;
   int64_t fail_safe_ns_ = 0;
   bool silent_ = false;
   bool drop_requested_ = false;
+  int sdo_answers_to_lose_ = 0;
   Stats stats_;
 
   std::atomic<double> spool_{0.0};

@@ -19,9 +19,15 @@ void PiController::update(double setpoint, const Sample& sample, Command& comman
   const double p = config_.kp * error;
   const double candidate = integrator_ + config_.ki * config_.period_s * error;
   const double unsat_with_candidate = p + candidate;
+  // The valve is not following (the driver says so): the error does not
+  // answer the command, and integrating it would wind up whatever the valve
+  // takes once it follows again.
+  const bool not_following = ((sample.outputs_not_following >> config_.output_index) & 1U) != 0;
   bool held = false;
-  if (config_.anti_windup == AntiWindup::kConditional &&
-      ((unsat_with_candidate > limit && error > 0.0) || (unsat_with_candidate < -limit && error < 0.0))) {
+  if (not_following) {
+    held = true;
+  } else if (config_.anti_windup == AntiWindup::kConditional &&
+             ((unsat_with_candidate > limit && error > 0.0) || (unsat_with_candidate < -limit && error < 0.0))) {
     held = true;  // integrating would only push further into saturation
   } else {
     integrator_ = candidate;

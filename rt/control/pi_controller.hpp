@@ -1,6 +1,9 @@
 // The PI law of seed 000 (eq. 9-10), written as a true discrete integrator
 // (the paper's u = Kp e + Ki e Ts has none; docs/rig-models.md 1.5.5):
 //   e_k = r_k - y_k,  I_k = I_{k-1} + Ki Ts e_k,  u_k = sat(Kp e_k + I_k)
+// The integrator is held (I_k = I_{k-1}) by the anti-windup below and on a
+// tick whose sample says the output's actuator is not following
+// (Sample::outputs_not_following).
 #pragma once
 
 #include "rt/control/controller.hpp"

@@ -407,3 +407,9 @@ TEST_F(WireFaultMatrix, CanHeartbeatLossNullsTheValve) {
 TEST_F(WireFaultMatrix, EmcyNullsTheValve) {
   run_on_wire("modbus_canopen", "emcy@3:0x5000:1", 24, 24);
 }
+
+TEST_F(WireFaultMatrix, ValveLeavingDeviceModeActiveNullsTheValve) {
+  // HOLD for 0.5 s: the valve goes to its hold setpoint (null) itself; the
+  // loop faults and makes it safe, so it finds null when it comes back.
+  run_on_wire("modbus_canopen", "hold@3:0.5", 24, 24);
+}

@@ -25,6 +25,11 @@ TEST(FaultSpec, ParsesEveryKind) {
   f = parse_fault_spec("emcy@3:0x5000:1");
   EXPECT_EQ(f.code, 0x5000);
   EXPECT_EQ(f.error_register, 1);
+  f = parse_fault_spec("hold@3:0.5");
+  EXPECT_EQ(f.kind, FaultKind::kHold);
+  EXPECT_DOUBLE_EQ(f.duration_s, 0.5);
+  EXPECT_TRUE(fault_on_wire(FaultKind::kHold));
+  EXPECT_FALSE(fault_in_process(FaultKind::kHold));
 }
 
 TEST(FaultSpec, BadSpecsNameWhatIsWrong) {
@@ -43,6 +48,7 @@ TEST(FaultSpec, BadSpecsNameWhatIsWrong) {
   EXPECT_NE(message("exception@1:x_r:0").find("1..255"), std::string::npos);
   EXPECT_NE(message("stuck@1:").find("channel"), std::string::npos);
   EXPECT_NE(message("emcy@1:zz:1").find("EMCY code 'zz'"), std::string::npos);
+  EXPECT_NE(message("hold@1").find("hold@TIME:DURATION"), std::string::npos);
 }
 
 TEST(FaultSpec, ParsesTheSimulatedDriversKinds) {

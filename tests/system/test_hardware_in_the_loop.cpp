@@ -17,88 +17,19 @@
 #include <regex>
 #include <sstream>
 
-#include "background_process.hpp"
-#include "process.hpp"
-#include "read_file.hpp"
-#include "wire_config.hpp"
+#include "rig_sim_fixture.hpp"
 
-using rigctl::test::BackgroundProcess;
-using rigctl::test::run_command;
+using namespace rigctl::test;
 namespace fs = std::filesystem;
 
 namespace {
 
-const std::string kRigctl = RIGCTL_BINARY;
-const std::string kConfig = std::string(RIGCTL_SOURCE_DIR) + "/config/quarter_car.yaml";
+const std::string kConfig = kShippedConfig;
 constexpr double kPeriod = 0.0025;
-constexpr double kMaxAge = rigctl::test::kWireMaxAge;
+constexpr double kMaxAge = kWireMaxAge;
 
-using rigctl::test::read_file;
-
-struct RunFile {
-  std::vector<std::string> names;
-  std::vector<std::vector<double>> rows;
-  std::vector<double> column(const std::string& name) const {
-    const auto it = std::find(names.begin(), names.end(), name);
-    EXPECT_NE(it, names.end()) << name;
-    const auto k = static_cast<std::size_t>(it - names.begin());
-    std::vector<double> out;
-    for (const auto& r : rows) out.push_back(r[k]);
-    return out;
-  }
-};
-
-RunFile read_run_file(const std::string& path) {
-  RunFile f;
-  std::ifstream in(path);
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.empty() || line[0] == '#') continue;
-    std::stringstream ss(line);
-    std::string cell;
-    if (f.names.empty()) {
-      while (std::getline(ss, cell, ',')) f.names.push_back(cell);
-      continue;
-    }
-    std::vector<double> row;
-    while (std::getline(ss, cell, ',')) row.push_back(std::stod(cell));
-    f.rows.push_back(row);
-  }
-  return f;
-}
-
-class HardwareInTheLoop : public ::testing::Test {
+class HardwareInTheLoop : public RigSimTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("rigctl_hil_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-
-  // The shipped config with another driver line and the test's timing
-  // (tests/support/wire_config.hpp).
-  std::string write_config(const std::string& driver, int port, double heartbeat_timeout_s = kMaxAge) {
-    const std::string file = path(driver + ".yaml");
-    std::ofstream(file) << rigctl::test::wire_config(driver, port, path("valve.sock"), heartbeat_timeout_s);
-    return file;
-  }
-
-  // Starts rig-sim on a free port; returns the port.
-  int start_rig_sim(const std::vector<std::string>& extra) {
-    std::vector<std::string> argv{kRigctl, "rig-sim", write_config("sim", 1502), "--modbus", "127.0.0.1:0"};
-    argv.insert(argv.end(), extra.begin(), extra.end());
-    // A fresh output file per start: waiting on an old one would find the
-    // previous instance's port.
-    sim_ = std::make_unique<BackgroundProcess>(argv, path("rig-sim-" + std::to_string(++sims_) + ".out"));
-    EXPECT_TRUE(sim_->wait_for("modbus listening on", 60.0)) << sim_->output();
-    std::smatch m;
-    const std::string out = sim_->output();
-    if (!std::regex_search(out, m, std::regex("modbus listening on 127\\.0\\.0\\.1:(\\d+)"))) return -1;
-    return std::stoi(m[1].str());
-  }
-
   // Waits until rig-sim's plant, which sits with the valve closed until the
   // loop starts, has settled (about 0.5 s; 1 s of its clock): the run then
   // starts from the same state however long a loaded machine takes to
@@ -115,10 +46,6 @@ class HardwareInTheLoop : public ::testing::Test {
         60.0))
         << sim_->output();
   }
-
-  std::unique_ptr<BackgroundProcess> sim_;
-  int sims_ = 0;
-  fs::path dir_;
 };
 
 // Max and RMS of the difference between a recording (t_a, a) and a
@@ -224,42 +151,6 @@ TEST_F(HardwareInTheLoop, StepTestWithTheCanopenValveMatchesTheInProcessSimulati
   EXPECT_FALSE(read_run_file(path("hw.csv")).column("x_s").empty());
 }
 
-namespace {
-// Rig time of the last row in a run file.
-double last_time(const std::string& csv) { return read_run_file(csv).column("t").back(); }
-
-const std::regex kValveReport("rig-sim: t = ([0-9.]+) s, valve u = ([-0-9.e]+)");
-
-// The valve commands rig-sim reported after time t (its own clock).
-std::vector<double> valve_commands_after(const std::string& sim_output, double t) {
-  std::vector<double> out;
-  for (auto it = std::sregex_iterator(sim_output.begin(), sim_output.end(), kValveReport); it != std::sregex_iterator();
-       ++it) {
-    if (std::stod((*it)[1].str()) > t) out.push_back(std::stod((*it)[2].str()));
-  }
-  return out;
-}
-
-// Call when the run has ended: waits until rig-sim has reported its valve
-// twice more (it does twice a second), however long a loaded machine takes,
-// then returns the commands it reported after time t. Waiting for the
-// reports, not sleeping, is what makes "it stays at null" cover time after
-// the run whatever the scheduler does.
-std::vector<double> valve_commands_after_the_run(BackgroundProcess& sim, double t) {
-  const std::size_t run_ended = sim.output().size();
-  const bool reported = sim.wait_until(
-      [&](const std::string& out) {
-        if (out.size() <= run_ended) return false;
-        const std::string later = out.substr(run_ended);
-        const auto reports = std::sregex_iterator(later.begin(), later.end(), kValveReport);
-        return std::distance(reports, std::sregex_iterator()) >= 2;
-      },
-      60.0);
-  EXPECT_TRUE(reported) << "rig-sim stopped reporting its valve\n" << sim.output();
-  return valve_commands_after(sim.output(), t);
-}
-}  // namespace
-
 TEST_F(HardwareInTheLoop, ModbusExceptionOnTheSensorsMakesTheRigSafeAndSaysWhy) {
   // From 3 s rig-sim answers reads of x_r's registers (the whole input block)
   // with exception 0x04; the writes of the valve command still get through.
@@ -306,7 +197,9 @@ TEST_F(HardwareInTheLoop, LostValveHeartbeatFaultsTheLoopAndNullsTheValve) {
   const auto run = run_command(kRigctl + " run " + write_config("modbus_canopen", port, kHeartbeatTimeout) +
                                " --duration 10 --log " + path("f.lcm") + " --csv " + path("f.csv"));
   EXPECT_EQ(run.exit_code, 3) << run.output;
-  EXPECT_NE(run.output.find("faulted (input_invalid: x_s"), std::string::npos) << run.output;
+  // The fault line names the CANopen cause, not only the flagged input.
+  EXPECT_NE(run.output.find("faulted (canopen valve node 1: heartbeat lost"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("input x_s flagged invalid"), std::string::npos) << run.output;
   // Faulted within 21 periods of the last heartbeat. The run's rig time
   // started after rig-sim's (rig-sim was up first), so in the run's time
   // the fault came before 4 s: a run that starts late only adds margin.
@@ -324,7 +217,9 @@ TEST_F(HardwareInTheLoop, EmcyFromTheValveIsDecodedAndFaultsTheLoop) {
   const auto run = run_command(kRigctl + " run " + write_config("modbus_canopen", port) + " --duration 10 --log " +
                                path("f.lcm"));
   EXPECT_EQ(run.exit_code, 3) << run.output;
-  EXPECT_NE(run.output.find("faulted (input_invalid: x_s"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("faulted (canopen valve node 1: EMCY 0x5000 (device hardware), error register 0x01 (generic)"),
+            std::string::npos)
+      << run.output;
   EXPECT_NE(read_file(path("f.lcm")).find("0x5000"), std::string::npos) << "EMCY code in the log";
 }
 

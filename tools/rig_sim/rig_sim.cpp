@@ -78,7 +78,8 @@ class FaultSchedule {
       if (!fault_on_wire(f.kind)) {
         throw std::invalid_argument("fault '" + f.text + "' is injected in the simulated driver: `rigctl run --fault` with driver: sim");
       }
-      if ((f.kind == FaultKind::kHeartbeat || f.kind == FaultKind::kEmcy) && valve_ == nullptr) {
+      if ((f.kind == FaultKind::kHeartbeat || f.kind == FaultKind::kEmcy || f.kind == FaultKind::kHold) &&
+          valve_ == nullptr) {
         throw std::invalid_argument("fault '" + f.text + "' needs the CANopen valve (--can-socket)");
       }
       if (f.kind == FaultKind::kException || f.kind == FaultKind::kStuck || f.kind == FaultKind::kRail) {
@@ -136,6 +137,7 @@ class FaultSchedule {
       case FaultKind::kEmcy:
         valve_->send_emcy(static_cast<uint16_t>(f.code), static_cast<uint8_t>(f.error_register));
         break;
+      case FaultKind::kHold: valve_->drop_to_hold(f.duration_s > 0.0 ? f.duration_s : 1e9); break;
       default: break;  // not on the wire: refused by the constructor
     }
   }
@@ -165,6 +167,7 @@ void run_rig_sim(const RigSimOptions& o, const std::atomic<bool>& stop, std::ost
   if (!config.modbus) throw ConfigError(config.file + ": modbus: missing (rig-sim exposes the rig's Modbus DAQ)");
   const bool with_valve = !o.can_socket.empty();
   if (with_valve && !config.canopen) throw ConfigError(config.file + ": canopen: missing (needed for --can-socket)");
+  if (!with_valve && !o.valve_options.empty()) throw std::invalid_argument("--valve needs the CANopen valve (--can-socket)");
 
   // The simulated hardware answers like hardware: its threads (created
   // below, inheriting this policy) run at real-time priority when permitted,
@@ -186,8 +189,11 @@ void run_rig_sim(const RigSimOptions& o, const std::atomic<bool>& stop, std::ost
   if (with_valve) {
     SimCanopenValveConfig vc;
     vc.node_id = config.canopen->node_id;
+    vc.setpoint_rpdo = config.canopen->setpoint_rpdo;
+    vc.actual_tpdo = config.canopen->actual_tpdo;
     // The plant models the spool lag itself: the node passes the setpoint on.
     vc.spool_time_constant_s = 0.0;
+    for (const auto& option : o.valve_options) apply_sim_valve_option(option, vc);
     valve = std::make_unique<SimCanopenValve>(o.can_socket, vc);
     out << "rig-sim: canopen valve on " << o.can_socket << "\n";
   }

@@ -22,6 +22,7 @@ struct RigSimOptions {
   std::string modbus_tcp;   // "HOST:PORT" (port 0: pick one and print it)
   std::string modbus_rtu;   // serial device path
   std::string can_socket;   // seqpacket socket path for the CANopen valve
+  std::vector<std::string> valve_options;  // the simulated valve's behaviours (drivers/sim/sim_canopen_valve_config.hpp)
   std::optional<double> duration_s;  // default: until SIGINT/SIGTERM
   std::vector<FaultSpec> faults;
   // The DAQ module's output watchdog: no write from the controller for this

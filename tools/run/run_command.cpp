@@ -55,6 +55,28 @@ std::string describe(const DistributionSummary& d) {
   return os.str();
 }
 
+// Why the run ended, for the console: the event and its channel, or, for an
+// input the driver flagged and knows why (a CANopen valve's heartbeat lost,
+// EMCY, reset, device state), the driver's cause.
+std::string end_reason(const Event& e, const ChannelLayout& layout, const Driver& driver) {
+  std::ostringstream os;
+  const auto index = static_cast<std::size_t>(e.channel);
+  if (e.code == EventCode::kInputInvalid && e.channel >= 0) {
+    const std::string cause = driver.input_fault_cause(index);
+    if (!cause.empty()) {
+      os << cause << "; input " << (index < layout.inputs.size() ? layout.inputs[index].name : "?") << " flagged invalid";
+      return os.str();
+    }
+  }
+  os << to_string(e.code);
+  if (e.channel >= 0) {
+    // Valve saturation names an output; every other trip an input.
+    const auto& channels = e.code == EventCode::kValveSaturated ? layout.outputs : layout.inputs;
+    os << ": " << (index < channels.size() ? channels[index].name : "?") << " = " << e.value;
+  }
+  return os.str();
+}
+
 }  // namespace
 
 RunReport run_rig(const RunOptions& options, const std::atomic<bool>& stop, std::ostream& out) {
@@ -210,15 +232,8 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
   report.loop = result;
 
   const auto& t = result.timing;
-  out << "  ended: " << to_string(result.final_state) << " (" << to_string(result.end_event.code);
-  if (result.end_event.channel >= 0) {
-    // Valve saturation names an output; every other trip an input.
-    const auto& channels =
-        result.end_event.code == EventCode::kValveSaturated ? meta.layout.outputs : meta.layout.inputs;
-    const auto index = static_cast<std::size_t>(result.end_event.channel);
-    out << ": " << (index < channels.size() ? channels[index].name : "?") << " = " << result.end_event.value;
-  }
-  out << ") after " << result.ticks << " ticks ("
+  out << "  ended: " << to_string(result.final_state) << " (" << end_reason(result.end_event, meta.layout, *rig.driver)
+      << ") after " << result.ticks << " ticks ("
       << std::fixed << std::setprecision(3) << static_cast<double>(result.ticks) * config.loop.period_s
       << " s rig time, " << report.wall_s << " s wall), rig state " << to_string(result.final_safety_state) << "\n";
   if (!options.fast) {

@@ -1,7 +1,7 @@
-// SDO expedited transfer (drivers/canopen/sdo.*): the exact request and
+// SDO transfers (drivers/canopen/protocol/sdo*): the exact request and
 // response bytes, a client and the simulated valve's server talking frame by
-// frame, every abort the server gives, the client's timeout, and responses
-// that are not valid answers.
+// frame (expedited and segmented uploads), every abort the server gives, the
+// client's timeout, and responses that are not valid answers.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -316,14 +316,10 @@ TEST(SdoClientProtocol, UnexpectedResponsesAreProtocolErrors) {
        0x05040001},
       {"toggle bit set in download response", false, make_frame(0x5A1, {0x70, 0x00, 0x63, 0x01, 0, 0, 0, 0}),
        0x05040001},
-      {"wrong index echo", false, make_frame(0x5A1, {0x60, 0x01, 0x63, 0x01, 0, 0, 0, 0}), 0x08000000},
-      {"wrong subindex echo", false, make_frame(0x5A1, {0x60, 0x00, 0x63, 0x02, 0, 0, 0, 0}), 0x08000000},
       {"download response to an upload", true, make_frame(0x5A1, {0x60, 0x00, 0x63, 0x01, 0, 0, 0, 0}), 0x05040001},
-      {"segmented upload response", true, make_frame(0x5A1, {0x41, 0x00, 0x63, 0x01, 12, 0, 0, 0}), 0x05040001},
       {"toggle bit set in upload response", true, make_frame(0x5A1, {0x53, 0x00, 0x63, 0x01, 0, 0, 0, 0}),
        0x05040001},
       {"upload segment", true, make_frame(0x5A1, {0x00, 1, 2, 3, 4, 5, 6, 7}), 0x05040001},
-      {"wrong index echo in upload", true, make_frame(0x5A1, {0x4B, 0x01, 0x63, 0x01, 0, 0, 0, 0}), 0x08000000},
   };
   for (const auto& c : cases) {
     SdoClient client(kNode, kTimeout);
@@ -338,6 +334,40 @@ TEST(SdoClientProtocol, UnexpectedResponsesAreProtocolErrors) {
     EXPECT_EQ(get_u16le(&r.to_send->data[1]), 0x6300) << c.what;
     EXPECT_EQ(r.to_send->data[3], 1) << c.what;
     EXPECT_EQ(get_u32le(&r.to_send->data[4]), c.abort_we_send) << c.what;
+  }
+}
+
+// An answer for another object is a late answer to an earlier request (one
+// that timed out and was sent again): dropped, and the transfer waits on
+// for its own answer.
+TEST(SdoClientProtocol, AnswerForAnotherObjectIsDroppedAndTheTransferGoesOn) {
+  struct Case {
+    const char* what;
+    bool upload;
+    CanFrame stale;
+    CanFrame own;
+  };
+  const Case cases[] = {
+      {"download, wrong index", false, make_frame(0x5A1, {0x60, 0x01, 0x63, 0x01, 0, 0, 0, 0}),
+       make_frame(0x5A1, {0x60, 0x00, 0x63, 0x01, 0, 0, 0, 0})},
+      {"download, wrong subindex", false, make_frame(0x5A1, {0x60, 0x00, 0x63, 0x02, 0, 0, 0, 0}),
+       make_frame(0x5A1, {0x60, 0x00, 0x63, 0x01, 0, 0, 0, 0})},
+      {"upload, the previous object's answer", true, make_frame(0x5A1, {0x43, 0x00, 0x10, 0x00, 0x98, 0x01, 0, 0}),
+       make_frame(0x5A1, {0x4B, 0x00, 0x63, 0x01, 0x34, 0x12, 0, 0})},
+  };
+  for (const auto& c : cases) {
+    SdoClient client(kNode, kTimeout);
+    ASSERT_TRUE(c.upload ? client.start_upload(0x6300, 1, kT0) : client.start_download(0x6300, 1, 5, 2, kT0));
+    const SdoResult stale = client.on_frame(c.stale, kT0 + 1);
+    EXPECT_EQ(stale.kind, SdoResult::Kind::kMalformed) << c.what;
+    EXPECT_EQ(stale.malformed, Malformed::kUnexpectedSdo) << c.what;
+    EXPECT_FALSE(stale.to_send.has_value()) << c.what << ": nothing aborted";
+    EXPECT_TRUE(client.busy()) << c.what;
+    const SdoResult own = client.on_frame(c.own, kT0 + 2);
+    EXPECT_EQ(own.kind, SdoResult::Kind::kDone) << c.what;
+    if (c.upload) {
+      EXPECT_EQ(own.value, 0x1234U) << c.what;
+    }
   }
 }
 
@@ -409,5 +439,137 @@ TEST(SdoTransfer, ConfigurationSequence) {
   const SdoResult r = p.exchange(p.client.start_upload(cia408::kControlWord, 0, now), now + 1);
   ASSERT_EQ(r.kind, SdoResult::Kind::kDone);
   EXPECT_EQ(r.value, cia408::kControlActive);
+  EXPECT_EQ(p.server.find(cia408::kDeviceMode, 0)->value, 1U);
+}
+
+// ---------------------------------------------------------------- segmented upload
+
+namespace {
+// The server's answer to the segment request the client asked for.
+CanFrame segment(uint8_t command, std::initializer_list<uint8_t> data) {
+  CanFrame f = make_frame(0x5A1, {command, 0, 0, 0, 0, 0, 0, 0});
+  uint8_t i = 1;
+  for (uint8_t b : data) f.data[i++] = b;
+  return f;
+}
+}  // namespace
+
+TEST(SdoSegmentedUpload, TenBytesInTwoSegmentsWithTheToggleAlternating) {
+  SdoClient c(kNode, kTimeout);
+  ASSERT_TRUE(c.start_upload(0x1008, 0, kT0));
+  // Initiate response: segmented, size indicated (10 bytes).
+  SdoResult r = c.on_frame(make_frame(0x5A1, {0x41, 0x08, 0x10, 0x00, 10, 0, 0, 0}), kT0 + 1);
+  ASSERT_EQ(r.kind, SdoResult::Kind::kPending);
+  ASSERT_TRUE(r.to_send.has_value());
+  expect_bytes(*r.to_send, 0x621, {0x60, 0, 0, 0, 0, 0, 0, 0});  // first segment request, toggle 0
+  // 7 bytes, toggle 0, more to come.
+  r = c.on_frame(segment(0x00, {'r', 'i', 'g', 'c', 't', 'l', ' '}), kT0 + 2);
+  ASSERT_EQ(r.kind, SdoResult::Kind::kPending);
+  ASSERT_TRUE(r.to_send.has_value());
+  expect_bytes(*r.to_send, 0x621, {0x70, 0, 0, 0, 0, 0, 0, 0});  // toggle 1
+  // 3 bytes (n = 4), toggle 1, last.
+  r = c.on_frame(segment(0x10 | (4 << 1) | 1, {'v', 'l', 'v'}), kT0 + 3);
+  ASSERT_EQ(r.kind, SdoResult::Kind::kDone);
+  EXPECT_TRUE(r.segmented);
+  EXPECT_EQ(r.size, 10);
+  EXPECT_EQ(std::string(r.bytes.begin(), r.bytes.begin() + r.size), "rigctl vlv");
+  EXPECT_EQ(r.value, 0x63676972U);  // the first four bytes, little-endian
+  EXPECT_FALSE(c.busy());
+}
+
+TEST(SdoSegmentedUpload, EachSegmentHasItsOwnTimeout) {
+  SdoClient c(kNode, kTimeout);
+  ASSERT_TRUE(c.start_upload(0x1008, 0, kT0));
+  ASSERT_EQ(c.on_frame(make_frame(0x5A1, {0x40, 0x08, 0x10, 0x00, 0, 0, 0, 0}), kT0 + kTimeout).kind,
+            SdoResult::Kind::kPending);
+  // Twice the timeout after the transfer began, within one of the request.
+  const SdoResult r = c.on_frame(segment(0x00 | (5 << 1) | 1, {0x34, 0x12}), kT0 + 2 * kTimeout);
+  ASSERT_EQ(r.kind, SdoResult::Kind::kDone);
+  EXPECT_EQ(r.size, 2);  // size not indicated: what came
+  EXPECT_EQ(r.value, 0x1234U);
+  ASSERT_TRUE(c.start_upload(0x1008, 0, kT0));
+  ASSERT_EQ(c.on_frame(make_frame(0x5A1, {0x40, 0x08, 0x10, 0x00, 0, 0, 0, 0}), kT0 + 1).kind, SdoResult::Kind::kPending);
+  const SdoResult late = c.poll(kT0 + 1 + kTimeout + 1);
+  EXPECT_EQ(late.kind, SdoResult::Kind::kAbort);
+  EXPECT_EQ(late.abort_code, 0x05040000U);
+}
+
+TEST(SdoSegmentedUpload, BadSegmentsAbortWithTheirCodes) {
+  struct Case {
+    const char* what;
+    uint8_t initiate;
+    uint32_t announced;
+    CanFrame segment;
+    uint32_t abort;
+  };
+  const Case cases[] = {
+      {"toggle not alternated", 0x41, 4, segment(0x10 | (3 << 1) | 1, {1, 2, 3, 4}), 0x05030000},
+      {"fewer bytes than announced", 0x41, 4, segment(0x00 | (5 << 1) | 1, {1, 2}), 0x06070010},
+      {"not a segment response", 0x41, 4, segment(0x60, {1, 2, 3, 4, 5, 6, 7}), 0x05040001},
+      {"announced more than the client takes", 0x41, 65, segment(0x01, {}), 0x05040005},
+  };
+  for (const auto& k : cases) {
+    SdoClient c(kNode, kTimeout);
+    ASSERT_TRUE(c.start_upload(0x1008, 0, kT0));
+    SdoResult r = c.on_frame(make_frame(0x5A1, {k.initiate, 0x08, 0x10, 0x00, static_cast<uint8_t>(k.announced), 0, 0, 0}),
+                             kT0 + 1);
+    if (r.kind == SdoResult::Kind::kPending) r = c.on_frame(k.segment, kT0 + 2);
+    EXPECT_EQ(r.kind, SdoResult::Kind::kProtocolError) << k.what;
+    EXPECT_EQ(r.abort_code, k.abort) << k.what;
+    ASSERT_TRUE(r.to_send.has_value()) << k.what;
+    EXPECT_EQ(get_u32le(&r.to_send->data[4]), k.abort) << k.what;
+    EXPECT_FALSE(c.busy()) << k.what;
+  }
+  // Nine segments of 7 bytes and one more: beyond the client's 64 bytes.
+  SdoClient c(kNode, kTimeout);
+  ASSERT_TRUE(c.start_upload(0x1008, 0, kT0));
+  SdoResult r = c.on_frame(make_frame(0x5A1, {0x40, 0x08, 0x10, 0x00, 0, 0, 0, 0}), kT0 + 1);
+  for (int i = 0; i < 10 && r.kind == SdoResult::Kind::kPending; ++i) {
+    r = c.on_frame(segment(static_cast<uint8_t>(i % 2 ? 0x10 : 0x00), {1, 2, 3, 4, 5, 6, 7}), kT0 + 2 + i);
+  }
+  EXPECT_EQ(r.kind, SdoResult::Kind::kProtocolError);
+  EXPECT_EQ(r.abort_code, 0x05040005U);
+}
+
+TEST(SdoSegmentedUpload, ServerAnswersSegmentedWhenAskedAndTheClientTakesIt) {
+  Pair p;
+  p.server.set_segmented_uploads(true);
+  const auto request = p.client.start_upload(0x1000, 0, kT0);
+  ASSERT_TRUE(request);
+  auto response = p.server.on_frame(*request);
+  ASSERT_TRUE(response);
+  expect_bytes(*response, 0x5A1, {0x41, 0x00, 0x10, 0x00, 4, 0, 0, 0});
+  SdoResult r = p.client.on_frame(*response, kT0 + 1);
+  int segments = 0;
+  while (r.kind == SdoResult::Kind::kPending && segments < 10) {
+    ASSERT_TRUE(r.to_send);
+    response = p.server.on_frame(*r.to_send);
+    ASSERT_TRUE(response);
+    r = p.client.on_frame(*response, kT0 + 2);
+    ++segments;
+  }
+  ASSERT_EQ(r.kind, SdoResult::Kind::kDone);
+  EXPECT_EQ(segments, 1);
+  EXPECT_TRUE(r.segmented);
+  EXPECT_EQ(r.value, 0x00010198U);
+  EXPECT_EQ(r.size, 4);
+  // A segment request with no segmented upload pending is refused.
+  const auto stray = p.server.on_frame(make_frame(0x621, {0x60, 0, 0, 0, 0, 0, 0, 0}));
+  ASSERT_TRUE(stray);
+  EXPECT_EQ(get_u32le(&stray->data[4]), 0x05040001U);
+}
+
+TEST(SdoServerWriteCheck, RefusalIsTheAbortCodeAndTheValueStays) {
+  Pair p;
+  p.server.set_write_check([](const OdEntry& e, uint32_t value) -> uint32_t {
+    return e.index == cia408::kDeviceMode && value > 1 ? 0x06090031 : 0;  // value too high
+  });
+  SdoResult r = p.exchange(p.client.start_download(cia408::kDeviceMode, 0, 2, 1, kT0));
+  EXPECT_EQ(r.kind, SdoResult::Kind::kAbort);
+  EXPECT_EQ(r.abort_code, 0x06090031U);
+  EXPECT_EQ(p.server.find(cia408::kDeviceMode, 0)->value, 0U);
+  EXPECT_EQ(p.server.writes(), 0U);
+  r = p.exchange(p.client.start_download(cia408::kDeviceMode, 0, 1, 1, kT0));
+  EXPECT_EQ(r.kind, SdoResult::Kind::kDone);
   EXPECT_EQ(p.server.find(cia408::kDeviceMode, 0)->value, 1U);
 }

@@ -90,3 +90,36 @@ TEST(PiController, AntiWindupCutsOvershootAfterSaturation) {
   EXPECT_LT(with, 0.002) << "conditional integration: little overshoot";
   EXPECT_GT(without, 3.0 * with + 0.005) << "a wound-up integrator overshoots far more";
 }
+
+// A tick whose sample says the valve is not following: the command is
+// still computed and recorded, the error is not integrated; once it follows
+// again the integrator goes on from where it was, with nothing wound up.
+TEST(PiController, IntegratorIsHeldWhileTheOutputIsNotFollowing) {
+  PiConfig cfg;
+  cfg.kp = 80.0;
+  cfg.ki = 60.0;
+  cfg.period_s = 0.0025;
+  cfg.output_index = 1;
+  PiController pi(cfg);
+  Sample s;
+  s.value[0] = 0.0;
+  Command c;
+  ControllerTerms t;
+  pi.update(0.005, s, c, t);  // following: one step of integration
+  const double before = pi.integrator();
+  EXPECT_GT(before, 0.0);
+  s.outputs_not_following = 1U << 1;
+  for (int k = 0; k < 200; ++k) {  // half a second of a valve in HOLD with a 5 mm error
+    pi.update(0.005, s, c, t);
+    EXPECT_TRUE(t.integrator_held);
+    EXPECT_DOUBLE_EQ(t.term[1], before);
+    EXPECT_DOUBLE_EQ(c.value[1], 80.0 * 0.005 + before);  // the command is still computed
+    EXPECT_DOUBLE_EQ(t.output, c.value[1]);
+  }
+  EXPECT_DOUBLE_EQ(pi.integrator(), before);
+  // Another output not following does not concern this controller.
+  s.outputs_not_following = 1U << 0;
+  pi.update(0.005, s, c, t);
+  EXPECT_FALSE(t.integrator_held);
+  EXPECT_DOUBLE_EQ(pi.integrator(), before + 60.0 * 0.0025 * 0.005);
+}
