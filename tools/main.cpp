@@ -57,6 +57,8 @@ int main(int argc, char** argv) {
   run_cmd->add_flag("--operator", run.operator_mode, "Operator mode whatever safety.auto_sequence says: power up faulted, move only on `rigctl cmd` (docs/deployment.md)");
   run_cmd->add_option("--key", run.key_path, "Operator key file, overrides operator.key_file (mode 600)");
   std::vector<std::string> run_fault_texts;
+  std::string run_ws;
+  run_cmd->add_option("--ws", run_ws, "Serve the telemetry to Foxglove/Lichtblick on a WebSocket, [ADDR:]PORT (default address 127.0.0.1; port 0: any free port); overrides telemetry.websocket (docs/foxglove.md)");
   run_cmd->add_option("--fault", run_fault_texts, "Inject a fault in the simulated driver, KIND@TIME[:ARG...] (stuck, rail, noise, nan, offset, overrun, supply, burst; SAFETY.md); repeatable");
 
   std::string log_in, csv_out, prefix = "RIGCTL_";
@@ -142,6 +144,7 @@ int main(int argc, char** argv) {
     if (run_cmd->parsed()) {
       if (duration_opt->count() > 0) run.duration_s = duration;
       for (const auto& f : run_fault_texts) run.faults.push_back(rigctl::parse_fault_spec(f));
+      if (!run_ws.empty()) run.websocket = rigctl::parse_ws_endpoint(run_ws);
       install_stop_handlers();
       const auto report = rigctl::run_rig(run, g_stop, std::cout);
       return report.loop.final_state == rigctl::RigState::kFaulted ? 3 : 0;
