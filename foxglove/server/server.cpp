@@ -27,6 +27,14 @@ using Hdl = websocketpp::connection_hdl;
 // Past it the client is not keeping up and its messages wait in its own
 // bounded queue, which drops the oldest.
 constexpr std::size_t kMaxSocketBacklog = 256 * 1024;
+// The kernel's share of a client's backlog (it doubles the value): with
+// websocketpp's share above and the client's own queue, a client that stops
+// reading holds about a second of data, and one 50 ms away still gets
+// 2.5 MB/s, eight times what every channel at 400 Hz needs. Left to itself
+// the kernel would grow it to megabytes: ten seconds of stale data.
+constexpr int kSocketSendBuffer = 128 * 1024;
+// A client that does not answer the close handshake is not waited for longer.
+constexpr long kCloseTimeoutMs = 1000;
 // How often a client whose socket was full is looked at again when no new
 // message arrives to trigger it.
 constexpr auto kRetryInterval = std::chrono::milliseconds(20);
@@ -218,10 +226,14 @@ Server::Server(ServerOptions options) : impl_(std::make_unique<Impl>(std::move(o
   s.ws.clear_error_channels(websocketpp::log::elevel::all);
   s.ws.init_asio();
   s.ws.set_reuse_addr(true);
-  // Small messages at 400 Hz: send each at once rather than wait for Nagle.
-  s.ws.set_socket_init_handler([](Hdl, asio::ip::tcp::socket& socket) {
+  s.ws.set_close_handshake_timeout(kCloseTimeoutMs);
+  // After the accept (before it the socket is not open yet).
+  s.ws.set_tcp_post_init_handler([&s](Hdl hdl) {
     asio::error_code ec;
+    auto& socket = s.ws.get_con_from_hdl(hdl)->get_raw_socket();
+    // Small messages at 400 Hz: send each at once rather than wait for Nagle.
     socket.set_option(asio::ip::tcp::no_delay(true), ec);
+    socket.set_option(asio::socket_base::send_buffer_size(kSocketSendBuffer), ec);
   });
   s.ws.set_validate_handler([&s](Hdl hdl) { return s.validate(hdl); });
   s.ws.set_open_handler([&s](Hdl hdl) { s.on_open(hdl); });
@@ -275,8 +287,8 @@ void Server::stop() {
     for (const auto& hdl : hdls) s.ws.close(hdl, websocketpp::close::status::going_away, "rigctl stops", ec);
   });
   if (!s.thread.joinable()) return;
-  // A client that never answers the close handshake would hold run() for
-  // websocketpp's close timeout (5 s); that is the longest stop() takes.
+  // A client that never answers the close handshake holds run() for the
+  // close timeout; that is the longest stop() takes.
   s.thread.join();
 }
 

@@ -96,8 +96,8 @@ std::string json_of(const rigctl::controller_t& k) {
   for (std::size_t i = 0; i < k.term_names.size() && i < k.terms.size(); ++i) j["term_" + k.term_names[i]] = k.terms[i];
   j["output_unsaturated"] = k.output_unsaturated;
   j["output"] = k.output;
-  j["saturated"] = k.saturated;
-  j["integrator_held"] = k.integrator_held;
+  j["saturated"] = k.saturated != 0;  // LCM booleans are int8_t in C++
+  j["integrator_held"] = k.integrator_held != 0;
   return j.dump();
 }
 
