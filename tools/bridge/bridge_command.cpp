@@ -1,6 +1,8 @@
 #include "tools/bridge/bridge_command.hpp"
 
+#include <cerrno>
 #include <chrono>
+#include <cstring>
 #include <stdexcept>
 
 #include <lcm/lcm-cpp.hpp>
@@ -67,7 +69,10 @@ int run_bridge(const BridgeOptions& options, const std::atomic<bool>& stop, std:
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >= *options.duration_s;
   };
   while (!done()) {
-    if (lcm.handleTimeout(kPollMs) < 0) throw std::runtime_error("bridge: reading LCM failed on " + options.lcm_url);
+    // A signal interrupts the wait (EINTR): the loop's condition decides.
+    if (lcm.handleTimeout(kPollMs) < 0 && errno != EINTR) {
+      throw std::runtime_error("bridge: reading LCM failed on " + options.lcm_url + ": " + std::strerror(errno));
+    }
   }
   server.stop();
   out << "  received " << forwarder.received() << " LCM messages\n"
