@@ -77,8 +77,9 @@ class TelemetryPublisher final : public TelemetrySink {
   void set_diagnostics_source(std::function<DriverDiagnostics()> source, std::string driver_name);
 
   // A consumer of every message besides the bus and the log (the Foxglove
-  // server); it is called on the publisher thread. Set before start().
-  void set_tap(TelemetryTap* tap) { tap_ = tap; }
+  // server, a benchmark's clock); called on the publisher thread, in the
+  // order added. Add before start().
+  void add_tap(TelemetryTap* tap) { taps_.push_back(tap); }
 
   // From any non-real-time thread (the event log's writer): an event to
   // publish on the STATE channel (and log), e.g. a failing event log.
@@ -120,7 +121,7 @@ class TelemetryPublisher final : public TelemetrySink {
   std::optional<TelemetryRecord> latest_;
   std::function<DriverDiagnostics()> diagnostics_;
   std::string driver_name_;
-  TelemetryTap* tap_ = nullptr;
+  std::vector<TelemetryTap*> taps_;
   int64_t last_t_ns_ = 0;  // rig time of the newest record, for driver status time stamps
   RigState last_state_ = RigState::kStarting;
   SafetyState last_safety_state_ = SafetyState::kFaulted;

@@ -137,7 +137,8 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
   // reach the server's feed.
   const auto foxglove_server = make_foxglove_server(config, options);
   TelemetryPublisher publisher(meta, url, report.log_path, queue_capacity);
-  if (foxglove_server) publisher.set_tap(&foxglove_server->tap());
+  for (TelemetryTap* tap : options.telemetry_taps) publisher.add_tap(tap);
+  if (foxglove_server) publisher.add_tap(&foxglove_server->tap());
   Driver* driver = rig.driver.get();
   publisher.set_diagnostics_source([driver] { return driver->diagnostics(); }, std::string(to_string(config.driver)));
 

@@ -11,6 +11,7 @@
 #include "config/rig_config.hpp"
 #include "rt/loop/rig_loop.hpp"
 #include "drivers/sim/fault_spec.hpp"
+#include "rt/comms/telemetry_tap.hpp"
 #include "tools/run/ws_endpoint.hpp"
 
 namespace rigctl {
@@ -39,6 +40,9 @@ struct RunOptions {
   std::vector<FaultSpec> faults;
   // --ws [ADDR:]PORT: the Foxglove WebSocket server, over telemetry.websocket (docs/foxglove.md).
   std::optional<WsEndpoint> websocket;
+  // Further consumers of every telemetry message, called before the Foxglove
+  // server's feed (rigctl bench: the time each message left the publisher).
+  std::vector<TelemetryTap*> telemetry_taps;
 };
 
 struct RunReport {
