@@ -68,6 +68,7 @@ struct Server::Impl {
   std::map<std::string, std::pair<StatusLevel, std::string>> statuses;
   std::vector<Parameter> parameters;
   bool stopped = false;
+  std::atomic<bool> stopping{false};  // the flush timer must not re-arm once set
 
   explicit Impl(ServerOptions o) : options(std::move(o)) {}
 
@@ -214,7 +215,9 @@ struct Server::Impl {
   void arm_flush_timer() {
     flush_timer->expires_after(kFlushInterval);
     flush_timer->async_wait([this](const asio::error_code& ec) {
-      if (ec) return;  // cancelled: the server stops
+      // Cancelled, or it fired just as stop() cancelled it: not again, or
+      // the server's thread would never run out of work.
+      if (ec || stopping.load()) return;
       flush();
       arm_flush_timer();
     });
@@ -275,6 +278,7 @@ void Server::stop() {
     if (s.stopped) return;
     s.stopped = true;
   }
+  s.stopping.store(true);
   // On the server's thread: stop accepting, close every client, cancel the
   // timer; run() returns once nothing is left to do.
   asio::post(s.ws.get_io_service(), [&s] {

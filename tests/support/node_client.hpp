@@ -3,17 +3,13 @@
 // into the build folder; and what they need: a free port, their JSON results.
 #pragma once
 
-#include <netinet/in.h>
-#include <sys/socket.h>
-#include <unistd.h>
-
-#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "read_file.hpp"
+#include "tools/common/free_port.hpp"
 
 namespace rigctl::test {
 
@@ -34,23 +30,8 @@ inline std::string node_command(const std::string& script, const std::vector<std
   return command;
 }
 
-// A TCP port on 127.0.0.1 that the OS just had free. Another process could
-// take it before the server binds it; the port space is large enough that
-// this does not happen between parallel tests in practice.
-inline int free_tcp_port() {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  a.sin_port = 0;
-  socklen_t len = sizeof a;
-  if (fd < 0 || ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0 ||
-      ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len) != 0) {
-    throw std::runtime_error("free_tcp_port: no port");
-  }
-  ::close(fd);
-  return ntohs(a.sin_port);
-}
+// A port for a server a test starts: the program's own free_loopback_port.
+inline int free_tcp_port() { return rigctl::free_loopback_port(); }
 
 inline nlohmann::json read_json(const std::string& path) { return nlohmann::json::parse(read_file(path)); }
 

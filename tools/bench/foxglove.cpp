@@ -6,10 +6,6 @@
 // handing a message on to a client having it (p50, p99, max, all clients and
 // channels), and the loop's wake-up latency p99 with the clients against
 // without them (goal: latency p99 under 50 ms, wake-up p99 within 10 %).
-#include <netinet/in.h>
-#include <sys/socket.h>
-#include <unistd.h>
-
 #include <chrono>
 #include <map>
 #include <memory>
@@ -21,6 +17,7 @@
 #include "foxglove/server/server.hpp"
 #include "rt/histogram.hpp"
 #include "tools/bench/sections.hpp"
+#include "tools/common/free_port.hpp"
 
 namespace rigctl::bench {
 
@@ -82,19 +79,6 @@ class LatencyRecorder {
   DurationHistogram histogram_{10'000, 100'000};  // 10 us bins up to 1 s
   int64_t unmatched_ = 0;
 };
-
-int free_loopback_port() {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  socklen_t len = sizeof a;
-  const bool ok = fd >= 0 && ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0 &&
-                  ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len) == 0;
-  if (fd >= 0) ::close(fd);
-  if (!ok) throw std::runtime_error("no free port on 127.0.0.1");
-  return ntohs(a.sin_port);
-}
 
 Json loop_json(const LoopRun& run) {
   Json j = Json::object();

@@ -9,7 +9,7 @@ using namespace rigctl::foxglove;
 namespace {
 
 rigctl::state_t state(const std::string& safety, const std::string& event = "", const std::string& message = "") {
-  rigctl::state_t s;
+  rigctl::state_t s{};
   s.state = "running";
   s.safety_state = safety;
   s.event = event;

@@ -15,7 +15,7 @@ using nlohmann::json;
 namespace {
 
 rigctl::sample_t sample() {
-  rigctl::sample_t s;
+  rigctl::sample_t s{};
   s.utime = 1'700'000'000'000'000;
   s.tick = 12;
   s.t = 0.03;
@@ -44,7 +44,7 @@ TEST(TelemetryJson, SampleFieldsAreTheRunFileColumns) {
 }
 
 TEST(TelemetryJson, CommandNamesTheSetpointColumnAndTheOutputs) {
-  rigctl::command_t c;
+  rigctl::command_t c{};
   c.t = 0.03;
   c.setpoint_name = "x_ref";
   c.setpoint = 0.08;
@@ -58,7 +58,7 @@ TEST(TelemetryJson, CommandNamesTheSetpointColumnAndTheOutputs) {
 }
 
 TEST(TelemetryJson, ControllerFlagsAreBooleansAndTermsNamed) {
-  rigctl::controller_t k;
+  rigctl::controller_t k{};
   k.controller = "pi";
   k.term_names = {"p", "i"};
   k.terms = {0.5, 0.1};
@@ -72,7 +72,7 @@ TEST(TelemetryJson, ControllerFlagsAreBooleansAndTermsNamed) {
 }
 
 TEST(TelemetryJson, TimingDurationsAreSeconds) {
-  rigctl::timing_t m;
+  rigctl::timing_t m{};
   m.tick = 400;
   m.period_ns = 2'500'000;
   m.latency_p99_ns = 50'000;
