@@ -75,6 +75,9 @@ ClientRequest read_request(const json& j) {
     if (r.kind == ClientRequest::Kind::kGetParameters && j.contains("parameterNames")) {
       r.parameter_names = j["parameterNames"].get<std::vector<std::string>>();
     }
+    if (r.kind == ClientRequest::Kind::kSetParameters) {  // answered with the values they keep
+      for (const auto& p : j.at("parameters")) r.parameter_names.push_back(p.at("name").get<std::string>());
+    }
   } else if (r.op == "advertise" || r.op == "unadvertise" || r.op == "subscribeParameterUpdates" ||
              r.op == "unsubscribeParameterUpdates" || r.op == "subscribeConnectionGraph" ||
              r.op == "unsubscribeConnectionGraph" || r.op == "fetchAsset") {

@@ -38,7 +38,7 @@ struct ClientRequest {
   Kind kind = Kind::kUnknown;
   std::vector<std::pair<uint32_t, uint32_t>> subscriptions;  // (subscription id, channel id)
   std::vector<uint32_t> unsubscriptions;                     // subscription ids
-  std::vector<std::string> parameter_names;                  // empty: all
+  std::vector<std::string> parameter_names;                  // get: empty for all; set: the names to be set
   std::string request_id;
   std::string op;     // as sent
   std::string error;  // why the message could not be read ("" when it could)

@@ -7,11 +7,15 @@
 //
 //   node foxglove_client.cjs --url ws://127.0.0.1:PORT --subprotocol foxglove.websocket.v1
 //        --topic RIGCTL_SAMPLE --count N --out RESULT.json
-//        [--subscribe-all] [--stall] [--until-status PREFIX] [--connect-timeout-s 120]
+//        [--subscribe-all] [--stall] [--until-status PREFIX] [--until-removed PREFIX]
+//        [--probe-read-only] [--connect-timeout-s 120]
 //
 // --stall: after the first message, stop reading the socket (a client that
 // hangs); the script then waits for the server to close the connection.
 // --until-status PREFIX: done once a status whose id starts with PREFIX came.
+// --until-removed PREFIX: done once such a status was removed (removeStatus).
+// --probe-read-only: also try to set a parameter and to publish (advertise a
+// client channel); the answers go into the result.
 // Prints "started", "connected", "subscribed" as it gets there.
 "use strict";
 const fs = require("fs");
@@ -20,7 +24,7 @@ const WebSocket = require("ws");
 const Ajv = require("ajv");
 
 function parseArgs(argv) {
-  const args = { count: 0, connectTimeoutS: 120, subscribeAll: false, stall: false, untilStatus: "" };
+  const args = { count: 0, connectTimeoutS: 120, subscribeAll: false, stall: false, untilStatus: "", untilRemoved: "", probeReadOnly: false };
   for (let i = 2; i < argv.length; i++) {
     const key = argv[i];
     const next = () => argv[++i];
@@ -32,6 +36,8 @@ function parseArgs(argv) {
     else if (key === "--subscribe-all") args.subscribeAll = true;
     else if (key === "--stall") args.stall = true;
     else if (key === "--until-status") args.untilStatus = next();
+    else if (key === "--until-removed") args.untilRemoved = next();
+    else if (key === "--probe-read-only") args.probeReadOnly = true;
     else if (key === "--connect-timeout-s") args.connectTimeoutS = Number(next());
     else throw new Error(`unknown argument ${key}`);
   }
@@ -45,7 +51,8 @@ const args = parseArgs(process.argv);
 const result = {
   subprotocol: null, serverInfo: null, channels: [], schemaFields: [], received: 0, firstTick: null,
   lastTick: null, gaps: 0, outOfOrder: 0, invalid: 0, validationErrors: [], timeOffsetSpreadNs: 0,
-  statuses: [], removedStatuses: [], messages: [], parameters: null, closed: false, errors: [],
+  statuses: [], removedStatuses: [], messages: [], parameters: null, parametersAfterSet: null, closed: false,
+  errors: [],
 };
 const ajv = new Ajv({ allErrors: true });
 const validators = new Map();  // channel id -> validate function
@@ -104,13 +111,23 @@ function connect(deadline) {
   client.on("serverInfo", (info) => {
     result.serverInfo = info;
     if (info.capabilities.includes("parameters")) client.getParameters([], "all");
+    if (args.probeReadOnly) {
+      client.setParameters([{ name: "controller.kp", value: 1.0 }], "set");
+      client.advertise({ topic: "/hack", encoding: "json", schemaName: "x" });
+    }
   });
-  client.on("parameterValues", (p) => { result.parameters = p.parameters; });
+  client.on("parameterValues", (p) => {
+    if (p.id === "set") result.parametersAfterSet = p.parameters;
+    else result.parameters = p.parameters;
+  });
   client.on("status", (s) => {
     result.statuses.push(s);
     if (args.untilStatus && s.id && s.id.startsWith(args.untilStatus)) finish(0);
   });
-  client.on("removeStatus", (r) => { result.removedStatuses.push(...r.statusIds); });
+  client.on("removeStatus", (r) => {
+    result.removedStatuses.push(...r.statusIds);
+    if (args.untilRemoved && r.statusIds.some((id) => id.startsWith(args.untilRemoved))) finish(0);
+  });
   client.on("advertise", (channels) => {
     for (const c of channels) {
       result.channels.push({ id: c.id, topic: c.topic, encoding: c.encoding, schemaName: c.schemaName,
@@ -135,7 +152,7 @@ function connect(deadline) {
       args.stall = false;
       console.log("stalled");
     }
-    if (args.count > 0 && result.received >= args.count && !args.untilStatus) finish(0);
+    if (args.count > 0 && result.received >= args.count && !args.untilStatus && !args.untilRemoved) finish(0);
   });
   client.on("error", (e) => {
     if (!opened && Date.now() < deadline) return;  // the server is not up yet

@@ -7,13 +7,19 @@
 // network, and the server's port cannot collide with another test's.
 #include <gtest/gtest.h>
 
+#include <lcm/lcm-cpp.hpp>
+
+#include <atomic>
+#include <chrono>
 #include <filesystem>
 #include <string>
+#include <thread>
 
 #include "background_process.hpp"
 #include "foxglove_checks.hpp"
 #include "node_client.hpp"
 #include "process.hpp"
+#include "rigctl/state_t.hpp"
 #include "test_netns.hpp"
 
 namespace {
@@ -76,6 +82,80 @@ TEST_F(Bridge, ServesALogReplayedOnTheRigNetwork) {
   for (const auto& p : r["parameters"]) parameters[p["name"]] = p["value"].get<double>();
   EXPECT_EQ(parameters["controller.kp"], 80.0);
   EXPECT_EQ(parameters["limits.x_r.min"], -0.012);
+}
+
+rigctl::state_t state_message(int64_t tick, const std::string& safety, const std::string& event,
+                               const std::string& message) {
+  rigctl::state_t st{};
+  st.utime = 1'700'000'000'000'000 + tick * 2500;
+  st.tick = tick;
+  st.t = static_cast<double>(tick) * 0.0025;
+  st.state = "running";
+  st.safety_state = safety;
+  st.event = event;
+  st.message = message;
+  return st;
+}
+
+// The statuses over the wire: a trip that faults the rig is an error with
+// an id, and a fault reset removes it. The rig's STATE messages are
+// published by the test itself on the namespace's udpm, as a rig would.
+TEST_F(Bridge, ATripIsAStatusUntilTheFaultIsReset) {
+  TestNetns ns("bridge-status");
+  if (!ns.ready()) GTEST_SKIP() << ns.skip_reason();
+  const std::vector<std::string> in_ns = {"/usr/bin/env", "ip", "netns", "exec", ns.name()};
+  std::vector<std::string> bridge_argv = in_ns;
+  bridge_argv.insert(bridge_argv.end(), {kRigctl, "bridge", "--lcm-url", kUrl, "--ws", "127.0.0.1:8765"});
+  BackgroundProcess bridge(bridge_argv, path("bridge.out"));
+  ASSERT_TRUE(bridge.wait_for("foxglove: ws://127.0.0.1:8765", kTimeoutS)) << bridge.output();
+  BackgroundProcess client(node_argv("foxglove_client.cjs",
+                                     {"--url", "ws://127.0.0.1:8765", "--subprotocol", "foxglove.websocket.v1", "--topic",
+                                      "RIGCTL_STATE", "--until-removed", "trip:", "--out", path("client.json")},
+                                     in_ns),
+                           path("client.out"));
+  ASSERT_TRUE(client.wait_for("connected", kTimeoutS)) << client.output();
+
+  // The rig's side, from a thread inside the namespace: running, a limit
+  // trip that interlocks, the operator's reset. Sent again every 100 ms
+  // until the client has seen the removal (UDP may lose a datagram).
+  std::atomic<bool> done{false};
+  std::string ns_error;
+  std::thread rig([&] {
+    ns_error = ns.enter_this_thread();
+    if (!ns_error.empty()) return;
+    lcm::LCM lcm(kUrl);
+    const rigctl::state_t sequence[] = {
+        state_message(10, "running", "", ""),
+        state_message(20, "faulted", "limit_tripped", "x_r = 0.3 m outside its limits (action interlock)"),
+        state_message(30, "off", "fault_reset", "every fault cleared"),
+    };
+    while (!done.load()) {
+      for (const auto& st : sequence) {
+        lcm.publish("RIGCTL_STATE", &st);
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      }
+    }
+  });
+  const int status = client.wait();
+  done.store(true);
+  rig.join();
+  ASSERT_TRUE(ns_error.empty()) << ns_error;
+  ASSERT_EQ(status, 0) << client.output();
+
+  const auto r = read_json(path("client.json"));
+  bool error_trip = false;
+  for (const auto& s : r["statuses"]) {
+    if (s.value("id", "") == "trip:limit_tripped:x_r") {
+      error_trip = true;
+      EXPECT_EQ(s["level"], 2) << s;
+      EXPECT_NE(s["message"].get<std::string>().find("x_r = 0.3 m"), std::string::npos) << s;
+    }
+  }
+  EXPECT_TRUE(error_trip) << r["statuses"];
+  EXPECT_NE(std::find(r["removedStatuses"].begin(), r["removedStatuses"].end(), "trip:limit_tripped:x_r"),
+            r["removedStatuses"].end())
+      << r["removedStatuses"];
+  for (const auto& id : r["removedStatuses"]) EXPECT_NE(id, "rig_state") << "the rig state is replaced, never removed";
 }
 
 }  // namespace

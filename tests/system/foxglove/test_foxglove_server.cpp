@@ -71,7 +71,7 @@ TEST_F(FoxgloveServer, ClientsOfBothSubprotocolsGetEverySampleInOrderAsInTheLog)
   std::vector<std::unique_ptr<BackgroundProcess>> clients;
   for (const char* protocol : protocols) {
     clients.push_back(start_client(protocol, port, {"--subprotocol", protocol, "--topic", "RIGCTL_SAMPLE",
-                                                    "--count", "400", "--subscribe-all"}));
+                                                    "--count", "400", "--subscribe-all", "--probe-read-only"}));
   }
   auto run = start_run("run", {"--duration", "6", "--ws", "127.0.0.1:" + std::to_string(port)});
   for (auto& c : clients) ASSERT_EQ(c->wait(), 0) << c->output();
@@ -113,6 +113,14 @@ TEST_F(FoxgloveServer, ClientsOfBothSubprotocolsGetEverySampleInOrderAsInTheLog)
     for (const auto& p : r["parameters"]) parameters[p["name"]] = p["value"].get<double>();
     EXPECT_EQ(parameters["controller.kp"], 80.0);
     EXPECT_EQ(parameters["limits.x_r.max"], 0.172);
+    // Read-only: setting a gain answers the unchanged value and a warning;
+    // a client channel (client publishing) is refused.
+    ASSERT_EQ(r["parametersAfterSet"].size(), 1u) << r["parametersAfterSet"];
+    EXPECT_EQ(r["parametersAfterSet"][0]["value"], 80.0);
+    std::set<std::string> status_ids;
+    for (const auto& s : r["statuses"]) status_ids.insert(s.value("id", ""));
+    EXPECT_EQ(status_ids.count("parameters_read_only"), 1u) << r["statuses"];
+    EXPECT_EQ(status_ids.count("refused_advertise"), 1u) << r["statuses"];
   }
 }
 

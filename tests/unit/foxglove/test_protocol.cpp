@@ -55,7 +55,9 @@ TEST(Protocol, ClientRequestsAreReadAndPublishingIsRefused) {
   EXPECT_EQ(get.kind, ClientRequest::Kind::kGetParameters);
   EXPECT_EQ(get.request_id, "r1");
   EXPECT_EQ(get.parameter_names, std::vector<std::string>{"controller.kp"});
-  EXPECT_EQ(parse_client_request(R"({"op":"setParameters","parameters":[]})").kind, ClientRequest::Kind::kSetParameters);
+  const auto set = parse_client_request(R"({"op":"setParameters","parameters":[{"name":"controller.kp","value":1}],"id":"s"})");
+  EXPECT_EQ(set.kind, ClientRequest::Kind::kSetParameters);
+  EXPECT_EQ(set.parameter_names, std::vector<std::string>{"controller.kp"});
   EXPECT_EQ(parse_client_request(R"({"op":"advertise","channels":[]})").kind, ClientRequest::Kind::kRefused);
   const auto garbage = parse_client_request("{not json");
   EXPECT_EQ(garbage.kind, ClientRequest::Kind::kUnknown);
