@@ -19,7 +19,7 @@
 #include "foxglove_checks.hpp"
 #include "node_client.hpp"
 #include "process.hpp"
-#include "rigctl/state_t.hpp"
+#include "state_message.hpp"
 #include "test_netns.hpp"
 
 namespace {
@@ -84,19 +84,6 @@ TEST_F(Bridge, ServesALogReplayedOnTheRigNetwork) {
   EXPECT_EQ(parameters["limits.x_r.min"], -0.012);
 }
 
-rigctl::state_t state_message(int64_t tick, const std::string& safety, const std::string& event,
-                               const std::string& message) {
-  rigctl::state_t st{};
-  st.utime = 1'700'000'000'000'000 + tick * 2500;
-  st.tick = tick;
-  st.t = static_cast<double>(tick) * 0.0025;
-  st.state = "running";
-  st.safety_state = safety;
-  st.event = event;
-  st.message = message;
-  return st;
-}
-
 // The statuses over the wire: a trip that faults the rig is an error with
 // an id, and a fault reset removes it. The rig's STATE messages are
 // published by the test itself on the namespace's udpm, as a rig would.
@@ -125,9 +112,9 @@ TEST_F(Bridge, ATripIsAStatusUntilTheFaultIsReset) {
     if (!ns_error.empty()) return;
     lcm::LCM lcm(kUrl);
     const rigctl::state_t sequence[] = {
-        state_message(10, "running", "", ""),
-        state_message(20, "faulted", "limit_tripped", "x_r = 0.3 m outside its limits (action interlock)"),
-        state_message(30, "off", "fault_reset", "every fault cleared"),
+        state_message("running", "", "", 10),
+        state_message("faulted", "limit_tripped", "x_r = 0.3 m outside its limits (action interlock)", 20),
+        state_message("off", "fault_reset", "every fault cleared", 30),
     };
     while (!done.load()) {
       for (const auto& st : sequence) {

@@ -3,18 +3,14 @@
 #include <gtest/gtest.h>
 
 #include "foxglove/telemetry/rig_status.hpp"
+#include "state_message.hpp"
 
 using namespace rigctl::foxglove;
 
 namespace {
 
 rigctl::state_t state(const std::string& safety, const std::string& event = "", const std::string& message = "") {
-  rigctl::state_t s{};
-  s.state = "running";
-  s.safety_state = safety;
-  s.event = event;
-  s.message = message;
-  return s;
+  return rigctl::test::state_message(safety, event, message);
 }
 
 TEST(RigStatus, StateChangesReplaceOneStatusWithALevelForTheState) {
