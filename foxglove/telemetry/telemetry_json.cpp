@@ -143,10 +143,16 @@ std::string json_of(const rigctl::timing_t& m) {
                    m.latency_p50_ns, m.latency_p99_ns, m.latency_p999_ns);
   put_distribution(j, "compute", m.compute_count, m.compute_min_ns, m.compute_max_ns, m.compute_mean_ns,
                    m.compute_p50_ns, m.compute_p99_ns, m.compute_p999_ns);
+  // Where the compute time goes, step by step (rt/tick_stages.hpp).
+  for (std::size_t i = 0; i < m.stage_name.size(); ++i) {
+    j["stage_" + m.stage_name[i] + "_max"] = i < m.stage_max_ns.size() ? seconds(m.stage_max_ns[i]) : 0.0;
+    j["stage_" + m.stage_name[i] + "_mean"] = i < m.stage_mean_ns.size() ? seconds(m.stage_mean_ns[i]) : 0.0;
+  }
+  j["slowest_tick"] = m.slowest_tick;
   return j.dump();
 }
 
-std::string schema_of(const rigctl::timing_t&) {
+std::string schema_of(const rigctl::timing_t& m) {
   SchemaBuilder b;
   b.time();
   b.integer("tick", "loop tick");
@@ -159,6 +165,11 @@ std::string schema_of(const rigctl::timing_t&) {
   b.integer("dropped_records", "telemetry records the full queue dropped");
   describe_distribution(b, "wakeup_latency", "wake-up latency");
   describe_distribution(b, "compute", "compute time per tick");
+  for (const auto& name : m.stage_name) {
+    b.number("stage_" + name + "_max", "s", "the tick's " + name + " step, longest so far");
+    b.number("stage_" + name + "_mean", "s", "the tick's " + name + " step, mean");
+  }
+  b.integer("slowest_tick", "the tick with the longest compute so far; -1: none yet");
   return b.build("rigctl.Timing", "Loop timing since the start of the run, about once a second");
 }
 

@@ -76,7 +76,13 @@ TEST(TelemetryJson, TimingDurationsAreSeconds) {
   m.tick = 400;
   m.period_ns = 2'500'000;
   m.latency_p99_ns = 50'000;
+  m.stage_name = {"read"};
+  m.stage_max_ns = {4'000};
+  m.stage_mean_ns = {1'000.0};
+  m.slowest_tick = 7;
   const json j = json::parse(to_json(m));
+  EXPECT_DOUBLE_EQ(j["stage_read_max"].get<double>(), 4e-6);
+  EXPECT_EQ(j["slowest_tick"], 7);
   EXPECT_DOUBLE_EQ(j["period"].get<double>(), 0.0025);
   EXPECT_DOUBLE_EQ(j["t"].get<double>(), 1.0);
   EXPECT_DOUBLE_EQ(j["wakeup_latency_p99"].get<double>(), 50e-6);
