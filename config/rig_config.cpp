@@ -1,5 +1,7 @@
 #include "config/rig_config.hpp"
 
+#include <arpa/inet.h>
+
 #include <filesystem>
 
 #include "config/config_reader.hpp"
@@ -36,12 +38,28 @@ LoopConfig read_loop(ConfigReader r) {
   return c;
 }
 
+WebsocketConfig read_websocket(ConfigReader r) {
+  WebsocketConfig c;
+  if (r.has("address")) {
+    c.address = r.text("address");
+    in6_addr any{};
+    if (inet_pton(AF_INET, c.address.c_str(), &any) != 1 && inet_pton(AF_INET6, c.address.c_str(), &any) != 1) {
+      r.fail("address", "'" + c.address + "' is not an IPv4 or IPv6 address (e.g. 127.0.0.1, 0.0.0.0)");
+    }
+  }
+  c.port = static_cast<int>(r.integer("port", 0, 65535));
+  if (r.has("client_queue")) c.client_queue_messages = static_cast<int>(r.integer("client_queue", 1, 1'000'000));
+  r.reject_unknown_keys();
+  return c;
+}
+
 TelemetryConfig read_telemetry(ConfigReader r) {
   TelemetryConfig c;
   c.lcm_url = r.text("lcm_url");
   if (c.lcm_url.find("://") == std::string::npos) r.fail("lcm_url", "expected a URL such as memq:// or udpm://ADDR:PORT?ttl=0");
   c.channel_prefix = r.text("channel_prefix");
   c.log_dir = r.text("log_dir");
+  if (r.has("websocket")) c.websocket = read_websocket(r.child("websocket"));
   r.reject_unknown_keys();
   return c;
 }

@@ -38,10 +38,19 @@ struct LoopConfig {
   RealtimeConfig realtime;
 };
 
+// `telemetry.websocket` (optional): the Foxglove WebSocket server of
+// `rigctl run` (docs/foxglove.md); `--ws` overrides it.
+struct WebsocketConfig {
+  std::string address = "127.0.0.1";  // loopback: another address only when the config says so
+  int port = 8765;                    // Foxglove's default; 0: any free port
+  int client_queue_messages = 1024;   // per client, oldest dropped when full (foxglove/server/server.hpp)
+};
+
 struct TelemetryConfig {
   std::string lcm_url = "memq://";
   std::string channel_prefix = "RIGCTL_";
   std::string log_dir = "runs";
+  std::optional<WebsocketConfig> websocket;
 };
 
 struct ControllerConfig {

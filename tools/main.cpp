@@ -11,7 +11,9 @@
 #include "tools/cmd/cmd_command.hpp"
 #include "tools/diagnosis/diagnose_command.hpp"
 #include "tools/hidden_effects/make_run.hpp"
+#include "tools/bridge/bridge_command.hpp"
 #include "tools/runfile/log2csv.hpp"
+#include "tools/runfile/log2mcap.hpp"
 #include "tools/runfile/run_file_rig.hpp"
 #include "tools/suspension/optimize_command.hpp"
 #include "tools/rig_sim/rig_sim.hpp"
@@ -57,6 +59,8 @@ int main(int argc, char** argv) {
   run_cmd->add_flag("--operator", run.operator_mode, "Operator mode whatever safety.auto_sequence says: power up faulted, move only on `rigctl cmd` (docs/deployment.md)");
   run_cmd->add_option("--key", run.key_path, "Operator key file, overrides operator.key_file (mode 600)");
   std::vector<std::string> run_fault_texts;
+  std::string run_ws;
+  run_cmd->add_option("--ws", run_ws, "Serve the telemetry to Foxglove/Lichtblick on a WebSocket, [ADDR:]PORT (default address 127.0.0.1; port 0: any free port); overrides telemetry.websocket (docs/foxglove.md)");
   run_cmd->add_option("--fault", run_fault_texts, "Inject a fault in the simulated driver, KIND@TIME[:ARG...] (stuck, rail, noise, nan, offset, overrun, supply, burst; SAFETY.md); repeatable");
 
   std::string log_in, csv_out, prefix = "RIGCTL_";
@@ -64,6 +68,23 @@ int main(int argc, char** argv) {
   l2c->add_option("log", log_in, "LCM log written by rigctl run")->required();
   l2c->add_option("csv", csv_out, "CSV file to write")->required();
   l2c->add_option("--channel-prefix", prefix, "Telemetry channel prefix used by the run");
+
+  std::string mcap_in, mcap_out, mcap_prefix = "RIGCTL_";
+  auto* l2m = app.add_subcommand("log2mcap", "Convert a run's LCM log into an MCAP file for Foxglove, Lichtblick and PlotJuggler (docs/foxglove.md)");
+  l2m->add_option("log", mcap_in, "LCM log written by rigctl run")->required();
+  l2m->add_option("mcap", mcap_out, "MCAP file to write")->required();
+  l2m->add_option("--channel-prefix", mcap_prefix, "Telemetry channel prefix used by the run");
+
+  rigctl::BridgeOptions bridge;
+  std::string bridge_ws;
+  double bridge_duration = 0.0;
+  auto* bridge_cmd = app.add_subcommand("bridge", "Serve a rig network's LCM telemetry (or lcm-logplayer's) to Foxglove/Lichtblick on a WebSocket (docs/foxglove.md)");
+  bridge_cmd->add_option("--lcm-url", bridge.lcm_url, "LCM URL of the rig network, e.g. udpm://239.255.76.67:7667?ttl=1")->required();
+  bridge_cmd->add_option("--ws", bridge_ws, "[ADDR:]PORT to serve on (default address 127.0.0.1; port 0: any free port)")->required();
+  bridge_cmd->add_option("--channel-prefix", bridge.channel_prefix, "Telemetry channel prefix of the rig")->capture_default_str();
+  bridge_cmd->add_option("--config", bridge.config_path, "The rig's config: its gains and limits as read-only parameters")->check(CLI::ExistingFile);
+  bridge_cmd->add_option("--client-queue", bridge.client_queue_messages, "Messages queued per client before the oldest is dropped")->capture_default_str()->check(CLI::PositiveNumber);
+  auto* bridge_duration_opt = bridge_cmd->add_option("--duration", bridge_duration, "Stop after this many seconds (default: at SIGINT/SIGTERM)")->check(CLI::PositiveNumber);
 
   rigctl::RigSimOptions sim;
   double sim_duration = 0.0;
@@ -146,6 +167,7 @@ int main(int argc, char** argv) {
     if (run_cmd->parsed()) {
       if (duration_opt->count() > 0) run.duration_s = duration;
       for (const auto& f : run_fault_texts) run.faults.push_back(rigctl::parse_fault_spec(f));
+      if (!run_ws.empty()) run.websocket = rigctl::parse_ws_endpoint(run_ws);
       install_stop_handlers();
       const auto report = rigctl::run_rig(run, g_stop, std::cout);
       return report.loop.final_state == rigctl::RigState::kFaulted ? 3 : 0;
@@ -183,6 +205,21 @@ int main(int argc, char** argv) {
       return rigctl::run_bench(bench, g_stop, std::cout);
     }
     if (diag_cmd->parsed()) return rigctl::run_diagnose(diag, std::cout, std::cerr);
+    if (l2m->parsed()) {
+      const auto result = rigctl::log_to_mcap(mcap_in, mcap_out, mcap_prefix);
+      std::cout << "log2mcap: " << result.messages << " messages in " << result.chunks << " chunks written to " << mcap_out;
+      if (result.skipped > 0) std::cout << " (" << result.skipped << " events of other channels or undecodable skipped)";
+      std::cout << "\n";
+      for (const auto& [channel, n] : result.per_channel) std::cout << "  " << channel << ": " << n << "\n";
+      if (!result.warning.empty()) std::cerr << "rigctl log2mcap: warning: " << result.warning << "\n";
+      return 0;
+    }
+    if (bridge_cmd->parsed()) {
+      bridge.ws = rigctl::parse_ws_endpoint(bridge_ws);
+      if (bridge_duration_opt->count() > 0) bridge.duration_s = bridge_duration;
+      install_stop_handlers();
+      return rigctl::run_bridge(bridge, g_stop, std::cout);
+    }
     if (l2c->parsed()) {
       const auto result = rigctl::log_to_csv(log_in, csv_out, prefix);
       std::cout << "log2csv: " << result.rows << " rows of " << result.rig << " written to " << csv_out;

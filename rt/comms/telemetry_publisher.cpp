@@ -51,11 +51,13 @@ int16_t fill_channels(const std::vector<ChannelInfo>& channels, const std::array
   return static_cast<int16_t>(channels.size());
 }
 
-// The one place a message is encoded, published and logged, so that the log
-// holds exactly the bytes that went onto the bus. Returns 0, or the errno of
-// a failed log write (the caller reports it; the loop is never affected).
+// The one place a message is encoded, published, logged and handed to the taps
+// (the Foxglove server), so that the log and the taps hold exactly the bytes
+// that went onto the bus. Returns 0, or the errno of a failed log write (the
+// caller reports it; the loop is never affected).
 template <typename Msg>
-int emit(lcm::LCM& lcm, lcm::LogFile* log, const std::string& channel, int64_t utime, const Msg& msg) {
+int emit(lcm::LCM& lcm, lcm::LogFile* log, const std::vector<TelemetryTap*>& taps, const std::string& channel,
+         int64_t utime, const Msg& msg) {
   const int size = msg.getEncodedSize();
   std::vector<uint8_t> buf(static_cast<std::size_t>(size));
   if (msg.encode(buf.data(), 0, size) != size) {
@@ -67,6 +69,7 @@ int emit(lcm::LCM& lcm, lcm::LogFile* log, const std::string& channel, int64_t u
     static std::atomic<int64_t> failures{0};
     if (failures.fetch_add(1) % 10000 == 0) spdlog::warn("telemetry: publish on {} failed", channel);
   }
+  int result = 0;
   if (log != nullptr) {
     lcm::LogEvent ev{};
     ev.timestamp = utime;
@@ -74,9 +77,10 @@ int emit(lcm::LCM& lcm, lcm::LogFile* log, const std::string& channel, int64_t u
     ev.datalen = size;
     ev.data = buf.data();
     errno = 0;
-    if (log->writeEvent(&ev) != 0) return errno != 0 ? errno : EIO;
+    if (log->writeEvent(&ev) != 0) result = errno != 0 ? errno : EIO;
   }
-  return 0;
+  for (TelemetryTap* tap : taps) tap->on_message(channel, utime, buf.data(), buf.size());
+  return result;
 }
 
 // The tick's steps as arrays in the timing message (publisher thread: it may allocate).
@@ -149,7 +153,7 @@ void TelemetryPublisher::publish_driver_status() {
   m.num_counters = static_cast<int16_t>(m.counters.size());
   m.events = std::move(d.events);
   m.num_events = static_cast<int16_t>(m.events.size());
-  note_log_result(emit(*lcm_, log_.get(), channels_.driver, m.utime, m));
+  note_log_result(emit(*lcm_, log_.get(), taps_, channels_.driver, m.utime, m));
 }
 
 void TelemetryPublisher::start() {
@@ -206,7 +210,7 @@ void TelemetryPublisher::publish_state_event(const std::string& event, const std
   st.message = message;
   st.safety_state = std::string(to_string(last_safety_state_));
   // Not into a log that is failing: that would recurse.
-  emit(*lcm_, to_log ? log_.get() : nullptr, channels_.state, st.utime, st);
+  emit(*lcm_, to_log ? log_.get() : nullptr, taps_, channels_.state, st.utime, st);
 }
 
 void TelemetryPublisher::report_event(const std::string& event, const std::string& message) {
@@ -271,7 +275,7 @@ void TelemetryPublisher::publish_record(const TelemetryRecord& r) {
     s.rig = meta_.rig;
     s.status = static_cast<int32_t>(r.sample.status);
     s.num_channels = fill_channels(layout.inputs, r.sample.value, s.names, s.units, s.values);
-    note_log_result(emit(*lcm_, log, channels_.sample, utime, s));
+    note_log_result(emit(*lcm_, log, taps_, channels_.sample, utime, s));
 
     rigctl::command_t c;
     c.utime = utime;
@@ -280,7 +284,7 @@ void TelemetryPublisher::publish_record(const TelemetryRecord& r) {
     c.setpoint_name = meta_.setpoint_name;
     c.setpoint = r.controller.setpoint;
     c.num_outputs = fill_channels(layout.outputs, r.command.value, c.names, c.units, c.values);
-    note_log_result(emit(*lcm_, log, channels_.command, utime, c));
+    note_log_result(emit(*lcm_, log, taps_, channels_.command, utime, c));
 
     rigctl::controller_t k;
     k.utime = utime;
@@ -298,7 +302,7 @@ void TelemetryPublisher::publish_record(const TelemetryRecord& r) {
     k.output = r.controller.output;
     k.saturated = r.controller.saturated;
     k.integrator_held = r.controller.integrator_held;
-    note_log_result(emit(*lcm_, log, channels_.controller, utime, k));
+    note_log_result(emit(*lcm_, log, taps_, channels_.controller, utime, k));
   }
 
   if (first_record_ || r.state != last_state_ || r.safety_state != last_safety_state_ ||
@@ -311,7 +315,7 @@ void TelemetryPublisher::publish_record(const TelemetryRecord& r) {
     st.event = std::string(to_string(r.event.code));
     st.message = event_message(r.event, layout);
     st.safety_state = std::string(to_string(r.safety_state));
-    note_log_result(emit(*lcm_, log, channels_.state, utime, st));
+    note_log_result(emit(*lcm_, log, taps_, channels_.state, utime, st));
     first_record_ = false;
     last_state_ = r.state;
     last_safety_state_ = r.safety_state;
@@ -344,7 +348,7 @@ void TelemetryPublisher::publish_record(const TelemetryRecord& r) {
     m.compute_p99_ns = tm.compute.p99_ns;
     m.compute_p999_ns = tm.compute.p999_ns;
     fill_stages(tm.stages, m);
-    note_log_result(emit(*lcm_, log, channels_.timing, utime, m));
+    note_log_result(emit(*lcm_, log, taps_, channels_.timing, utime, m));
   }
 
   // Counts records (the unit dropped() counts), not LCM messages.

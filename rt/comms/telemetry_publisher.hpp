@@ -20,6 +20,7 @@
 #include "rt/sample.hpp"
 #include "rt/telemetry_record.hpp"
 #include "rt/comms/telemetry_sink.hpp"
+#include "rt/comms/telemetry_tap.hpp"
 
 namespace lcm {
 class LCM;
@@ -75,6 +76,11 @@ class TelemetryPublisher final : public TelemetrySink {
   // events, published on channels().driver and logged. Set before start().
   void set_diagnostics_source(std::function<DriverDiagnostics()> source, std::string driver_name);
 
+  // A consumer of every message besides the bus and the log (the Foxglove
+  // server, a benchmark's clock); called on the publisher thread, in the
+  // order added. Add before start().
+  void add_tap(TelemetryTap* tap) { taps_.push_back(tap); }
+
   // From any non-real-time thread (the event log's writer): an event to
   // publish on the STATE channel (and log), e.g. a failing event log.
   void report_event(const std::string& event, const std::string& message);
@@ -115,6 +121,7 @@ class TelemetryPublisher final : public TelemetrySink {
   std::optional<TelemetryRecord> latest_;
   std::function<DriverDiagnostics()> diagnostics_;
   std::string driver_name_;
+  std::vector<TelemetryTap*> taps_;
   int64_t last_t_ns_ = 0;  // rig time of the newest record, for driver status time stamps
   RigState last_state_ = RigState::kStarting;
   SafetyState last_safety_state_ = SafetyState::kFaulted;

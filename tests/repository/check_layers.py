@@ -21,8 +21,10 @@ LAYER_OF_FOLDER = {
     'rt/control': 'control', 'rt/safety': 'safety', 'rt/comms': 'comms', 'rt/loop': 'loop',
     'plant': 'plant',
     'drivers': 'drivers',
+    'foxglove': 'foxglove',
     'config': 'config',
     'tools/run': 'run', 'tools/cmd': 'run', 'tools/rig_sim': 'run', 'tools/runfile': 'run', 'tools/common': 'run',
+    'tools/bridge': 'run',
     'tools/hidden_effects': 'hidden_effects',
     'tools/diagnosis': 'diagnosis',
     'tools/suspension': 'suspension',
@@ -43,15 +45,18 @@ BELOW = {
     'drivers': {'base', 'plant'},
 }
 RT = {'control', 'safety', 'comms', 'loop'}
+# The Foxglove server and MCAP (foxglove/): fed by comms' telemetry, read by
+# run; nothing in rt includes it, so the tick cannot depend on it.
+BELOW['foxglove'] = BELOW['comms'] | {'comms'}
 BELOW['config'] = {'base', 'plant', 'drivers'} | RT
-BELOW['run'] = BELOW['config'] | {'config', 'lcmtypes'}
+BELOW['run'] = BELOW['config'] | {'config', 'lcmtypes', 'foxglove'}
 BELOW['hidden_effects'] = BELOW['run'] | {'run'}
 BELOW['diagnosis'] = BELOW['hidden_effects'] | {'hidden_effects'}
 BELOW['suspension'] = BELOW['run'] | {'run'}
 BELOW['bench'] = BELOW['diagnosis'] | {'diagnosis', 'suspension'}
 BELOW['program'] = BELOW['bench'] | {'bench'}
 
-SOURCE_FOLDERS = ('rt', 'plant', 'drivers', 'config', 'tools')
+SOURCE_FOLDERS = ('rt', 'plant', 'drivers', 'foxglove', 'config', 'tools')
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"')
 
 

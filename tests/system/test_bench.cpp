@@ -202,6 +202,18 @@ TEST(BenchCommand, QuickRunWritesEverySection) {
     ASSERT_TRUE(tick.contains(n)) << n;
     EXPECT_GT(member(member(tick, n), "ns_per_tick").number(), 0) << n;
   }
+
+  // Foxglove: three clients got every channel's messages through the
+  // server, each matched to the moment the publisher handed it on; both
+  // runs of the loop were measured (no timing thresholds here).
+  const Json& foxglove = member(sections, "foxglove");
+  expect_ran(foxglove, "foxglove");
+  EXPECT_GT(member(foxglove, "messages_received").number(), 0);
+  EXPECT_EQ(member(foxglove, "messages_unmatched").number(), 0);
+  EXPECT_EQ(member(member(foxglove, "end_to_end_latency"), "count").number(), member(foxglove, "messages_received").number());
+  for (const char* run : {"without_clients", "with_clients"}) {
+    EXPECT_GT(member(member(member(foxglove, run), "wakeup_latency"), "count").number(), 0) << run;
+  }
 }
 
 TEST(BenchCommand, UnknownSectionIsRejected) {

@@ -16,6 +16,7 @@
 #include <string>
 
 #include "config/rig_config.hpp"
+#include "tools/run/run_command.hpp"
 #include "tools/bench/bench_command.hpp"
 #include "tools/bench/json.hpp"
 #include "tools/bench/reference.hpp"
@@ -51,8 +52,22 @@ Section io_section();         // tools/bench/io.cpp
 Section diagnosis_section();  // tools/bench/diagnosis.cpp
 Section diagnosis_sweep_section();  // tools/bench/diagnosis.cpp
 Section scaling_section();    // tools/bench/scaling.cpp
+Section foxglove_section();   // tools/bench/foxglove.cpp
 
 Json skipped(const std::string& reason);
+
+struct LoopRun {
+  TimingSummary timing;
+  double wall_s = 0.0;
+  std::string console;  // what the run printed
+};
+
+// `rigctl run CONFIG --duration S` (the quarter car) in-process, on a thread
+// of its own so the SCHED_FIFO priority it takes ends with the thread; the
+// run log goes to the scratch directory and is removed. `adjust` may change
+// the run's options first (tools/bench/timing.cpp).
+LoopRun run_loop(Context& ctx, double seconds, const std::string& tag,
+                 const std::function<void(RunOptions&)>& adjust = {});
 
 // The commands the configured rig's own closed loop (rig assembly, RigLoop,
 // simulated time) puts out over `ticks` periods: what the plant benchmarks

@@ -25,22 +25,13 @@
 
 namespace rigctl::bench {
 
-namespace {
-
-struct LoopRun {
-  TimingSummary timing;
-  double wall_s = 0.0;
-};
-
-// `rigctl run CONFIG --duration S` in-process, on a thread of its own so the
-// SCHED_FIFO priority it takes ends with the thread; the run log goes to the
-// scratch directory and is removed.
-LoopRun run_loop(Context& ctx, double seconds, const std::string& tag) {
+LoopRun run_loop(Context& ctx, double seconds, const std::string& tag, const std::function<void(RunOptions&)>& adjust) {
   RunOptions o;
   o.config_path = ctx.quarter_car_config;
   o.duration_s = seconds;
   o.log_path = ctx.scratch.file("loop-" + tag + ".lcm");
   o.lcm_url = "memq://";
+  if (adjust) adjust(o);
   std::ostringstream console;  // the run's own report and status lines
   RunReport report;
   std::exception_ptr error;
@@ -56,8 +47,10 @@ LoopRun run_loop(Context& ctx, double seconds, const std::string& tag) {
   std::error_code ec;
   std::filesystem::remove(o.log_path, ec);
   if (error) std::rethrow_exception(error);
-  return {report.loop.timing, report.wall_s};
+  return {report.loop.timing, report.wall_s, console.str()};
 }
+
+namespace {
 
 struct CyclictestRun {
   Json json;

@@ -22,6 +22,8 @@
 #include "tools/runfile/log2csv.hpp"
 #include "tools/run/loop_heartbeat.hpp"
 #include "tools/run/operator_mode.hpp"
+#include "foxglove/telemetry/telemetry_server.hpp"
+#include "tools/run/rig_parameters.hpp"
 #include "tools/run/rig_assembly.hpp"
 #include "tools/run/service_notify.hpp"
 
@@ -75,6 +77,21 @@ std::string end_reason(const Event& e, const ChannelLayout& layout, const Driver
     os << ": " << (index < channels.size() ? channels[index].name : "?") << " = " << e.value;
   }
   return os.str();
+}
+
+// The Foxglove server of the run, when the config or --ws asks for one.
+std::unique_ptr<foxglove::TelemetryServer> make_foxglove_server(const RigConfig& config, const RunOptions& options) {
+  const auto ws = websocket_settings(config.telemetry.websocket, options.websocket);
+  if (!ws) return nullptr;
+  foxglove::ServerOptions so;
+  so.address = ws->address;
+  so.port = static_cast<uint16_t>(ws->port);
+  so.client_queue_messages = static_cast<std::size_t>(ws->client_queue_messages);
+  so.name = "rigctl " + std::string(to_string(config.rig));
+  so.metadata = {{"rig", std::string(to_string(config.rig))},
+                 {"driver", std::string(to_string(config.driver))},
+                 {"config", options.config_path}};
+  return std::make_unique<foxglove::TelemetryServer>(so, config.telemetry.channel_prefix, rig_parameters(config));
 }
 
 }  // namespace
@@ -139,7 +156,12 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
   const auto queue_capacity = options.telemetry_queue_records > 0
                                   ? options.telemetry_queue_records
                                   : static_cast<std::size_t>(10.0 / config.loop.period_s);
+  // Before the publisher: the publisher's last messages at its stop still
+  // reach the server's feed.
+  const auto foxglove_server = make_foxglove_server(config, options);
   TelemetryPublisher publisher(meta, url, report.log_path, queue_capacity);
+  for (TelemetryTap* tap : options.telemetry_taps) publisher.add_tap(tap);
+  if (foxglove_server) publisher.add_tap(&foxglove_server->tap());
   Driver* driver = rig.driver.get();
   publisher.set_diagnostics_source([driver] { return driver->diagnostics(); }, std::string(to_string(config.driver)));
 
@@ -166,6 +188,7 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
 
   rig.driver->start();
   publisher.start();  // before the real-time set-up: the publisher keeps normal priority
+  if (foxglove_server) foxglove_server->start();  // likewise
   events.start();
   // Threads started before the RealtimeSession keep normal priority.
   if (receiver) receiver->start();
@@ -179,6 +202,10 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
       << (meta.queue_policy == QueueFullPolicy::kWait ? "holds the loop back (simulated time: nothing is dropped)"
                                                        : "drops and counts (the tick never waits)")
       << "\n";
+  if (foxglove_server) {
+    out << "  foxglove: " << foxglove_server->url() << " serves " << config.telemetry.channel_prefix
+        << "* as JSON (Foxglove, Lichtblick; docs/foxglove.md)\n";
+  }
   if (receiver) {
     out << "  operator mode: the rig powers up faulted; commands on " << receiver->channel() << " (acks on "
         << receiver->ack_channel() << ")\n";
@@ -218,6 +245,7 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
       if (receiver) receiver->stop();
       events.stop();
       publisher.stop();  // keep what was recorded
+      if (foxglove_server) foxglove_server->stop();
       rig.driver->stop();
       throw;
     }
@@ -227,6 +255,7 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
   if (receiver) receiver->stop();  // before the event log closes: its last rejections go in
   events.stop();
   publisher.stop();
+  if (foxglove_server) foxglove_server->stop();
   rig.driver->stop();
   result.dropped_records = publisher.dropped();
   report.loop = result;
@@ -255,6 +284,7 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
       << "longest write+fsync " << es.max_fsync_ms << " ms" << (es.pending > 0 ? ", " + std::to_string(es.pending) + " NOT WRITTEN" : "")
       << ")\n";
   if (receiver) out << "  operator commands: " << describe_counters(receiver->counters()) << "\n";
+  if (foxglove_server) out << "  foxglove: " << foxglove_server->describe_clients() << "\n";
   if (publisher.log_failures() > 0) out << "  run log write failures: " << publisher.log_failures() << "\n";
   if (!report.csv_path.empty()) {
     const auto csv =

@@ -11,6 +11,8 @@
 #include "config/rig_config.hpp"
 #include "rt/loop/rig_loop.hpp"
 #include "drivers/sim/fault_spec.hpp"
+#include "rt/comms/telemetry_tap.hpp"
+#include "tools/run/ws_endpoint.hpp"
 
 namespace rigctl {
 
@@ -36,6 +38,11 @@ struct RunOptions {
   std::string key_path;        // --key: overrides operator.key_file
   // --fault KIND@TIME[:ARG...], after the config's `faults:`; simulated driver only (drivers/sim/sim_faults.hpp).
   std::vector<FaultSpec> faults;
+  // --ws [ADDR:]PORT: the Foxglove WebSocket server, over telemetry.websocket (docs/foxglove.md).
+  std::optional<WsEndpoint> websocket;
+  // Further consumers of every telemetry message, called before the Foxglove
+  // server's feed (rigctl bench: the time each message left the publisher).
+  std::vector<TelemetryTap*> telemetry_taps;
 };
 
 struct RunReport {

@@ -10,7 +10,6 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <map>
 #include <stdexcept>
@@ -23,6 +22,8 @@
 #include "rigctl/command_t.hpp"
 #include "rigctl/sample_t.hpp"
 #include "rigctl/timing_t.hpp"
+#include "rt/comms/telemetry_columns.hpp"
+#include "tools/runfile/lcm_log.hpp"
 
 namespace rigctl {
 
@@ -36,22 +37,6 @@ constexpr int64_t kJoinWindowTicks = 256;
 
 [[noreturn]] void fail(const std::string& path, const std::string& reason) {
   throw std::runtime_error("log2csv: '" + path + "': " + reason);
-}
-
-// lcm_eventlog resynchronises on garbage and would just report "no events",
-// so check the magic of the first event ourselves for a clear message.
-void check_is_lcm_log(const std::string& path) {
-  std::error_code ec;
-  if (!fs::exists(path, ec)) fail(path, "no such file");
-  if (!fs::is_regular_file(path, ec)) fail(path, "not a regular file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail(path, std::string("cannot open: ") + std::strerror(errno));
-  unsigned char magic[4] = {};
-  in.read(reinterpret_cast<char*>(magic), 4);
-  if (in.gcount() < 4) fail(path, "not an LCM log (empty or truncated)");
-  if (magic[0] != 0xED || magic[1] != 0xA1 || magic[2] != 0xDA || magic[3] != 0x01) {
-    fail(path, "not an LCM log (no LCM event sync word at the start)");
-  }
 }
 
 template <typename Msg>
@@ -71,8 +56,9 @@ struct Layout {
   std::string rig;
   std::vector<std::string> inputs;
   std::vector<bool> keep_input;  // written to the file (simulator truth channels may be left out)
-  std::string setpoint_name;
   std::vector<std::string> outputs;
+  // The file's columns after t, as every telemetry writer names them.
+  std::vector<TelemetryColumn> command_columns, input_columns;
   long sample_rate_hz = 0;  // 0 = unknown (fewer than two samples)
   // From the newest timing message: what a full telemetry queue did and how
   // many records it dropped, so a run file says whether it is complete.
@@ -107,13 +93,14 @@ Layout scan(const std::string& path, const std::string& sample_ch, const std::st
       if (!have_sample) {
         layout.rig = s.rig;
         layout.inputs = s.names;
+        layout.input_columns = sample_columns(s);
         have_sample = true;
       }
       tick_t.emplace_back(s.tick, s.t);
     } else if (ev.channel == command_ch && !have_command) {
       rigctl::command_t c;
       if (!decode(ev, c)) return;
-      layout.setpoint_name = c.setpoint_name;
+      layout.command_columns = command_columns(c);
       layout.outputs = c.names;
       have_command = true;
     } else if (ev.channel == timing_ch) {
@@ -191,10 +178,10 @@ void write_head(std::FILE* f, const Layout& layout, const std::string& log_path)
     std::fprintf(f, "# telemetry_queue_policy: %s\n", layout.queue_policy.c_str());
     std::fprintf(f, "# dropped_records: %lld\n", static_cast<long long>(layout.dropped_records));
   }
-  std::fprintf(f, "t,%s", layout.setpoint_name.c_str());
-  for (const auto& n : layout.outputs) std::fprintf(f, ",%s", n.c_str());
-  for (std::size_t i = 0; i < layout.inputs.size(); ++i)
-    if (layout.keep_input[i]) std::fprintf(f, ",%s", layout.inputs[i].c_str());
+  std::fputs(kTimeColumn, f);
+  for (const auto& c : layout.command_columns) std::fprintf(f, ",%s", c.name.c_str());
+  for (std::size_t i = 0; i < layout.input_columns.size(); ++i)
+    if (layout.keep_input[i]) std::fprintf(f, ",%s", layout.input_columns[i].name.c_str());
   std::fputc('\n', f);
 }
 
@@ -257,7 +244,7 @@ Log2CsvResult log_to_csv(const std::string& lcm_log_path, const std::string& csv
                          const std::string& channel_prefix, bool simulator_truth) {
   const std::string sample_ch = channel_prefix + "SAMPLE";
   const std::string command_ch = channel_prefix + "COMMAND";
-  check_is_lcm_log(lcm_log_path);
+  check_is_lcm_log(lcm_log_path, "log2csv");
   Layout layout = scan(lcm_log_path, sample_ch, command_ch, channel_prefix + "TIMING");
   for (const auto& name : layout.inputs) layout.keep_input.push_back(simulator_truth || name.rfind("sim_", 0) != 0);
 

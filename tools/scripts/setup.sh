@@ -13,7 +13,13 @@ packages=(cmake g++ make pkg-config liblcm-dev liblcm-bin libglib2.0-dev libmodb
           libboost-dev libbenchmark-dev rt-tests iproute2 socat
           libssl-dev   # libssl-dev: libcrypto HMAC-SHA256 for operator commands
           libsystemd-dev   # sd_notify: the service's readiness and watchdog (docs/deployment.md)
-          systemd)         # systemd-analyze: tests/system/test_systemd_units.cpp scores the units' hardening
+          systemd          # systemd-analyze: tests/system/test_systemd_units.cpp scores the units' hardening
+          # The Foxglove WebSocket server (foxglove/server): websocketpp, the
+          # maintained header-only WebSocket library Debian ships, on
+          # standalone asio; nlohmann-json for the protocol's JSON and the
+          # telemetry's JSON messages and schemas.
+          libwebsocketpp-dev libasio-dev nlohmann-json3-dev
+          nodejs)          # the tests' real clients (tests/node: Foxglove ws-protocol, @mcap/core), npm packages installed into the build folder
 for arg in "$@"; do
   case "$arg" in
     --plots) packages+=(python3 python3-numpy python3-matplotlib) ;;
@@ -23,6 +29,8 @@ for arg in "$@"; do
 done
 
 "$root/tools/scripts/install_packages.sh" setup "${packages[@]}"
+# Debian's nodejs comes without npm (a nodejs from elsewhere may bring its own).
+command -v npm >/dev/null || "$root/tools/scripts/install_packages.sh" setup npm
 
 cmake -S "$root" -B "$root/build" -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
 cmake --build "$root/build" -j"$(nproc)"

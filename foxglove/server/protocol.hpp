@@ -1,0 +1,51 @@
+// The Foxglove WebSocket protocol's messages as bytes: the JSON operations
+// the server sends, the binary message-data frame, and the parsing of what a
+// client sends. Pure functions, no sockets (docs/foxglove.md).
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "foxglove/server/server.hpp"
+
+namespace rigctl::foxglove {
+
+struct AdvertisedChannel {
+  uint32_t id = 0;
+  std::string topic;
+  std::string schema_name;
+  std::string schema;  // JSON Schema text
+};
+
+std::string server_info_json(const std::string& name, const std::map<std::string, std::string>& metadata,
+                             const std::string& session_id);
+std::string advertise_json(const std::vector<AdvertisedChannel>& channels);
+std::string status_json(const std::string& id, StatusLevel level, const std::string& message);
+std::string remove_status_json(const std::vector<std::string>& ids);
+// parameterValues; request_id "" leaves out `id`.
+std::string parameter_values_json(const std::vector<Parameter>& parameters, const std::string& request_id);
+
+// Binary opcode 0x01: subscription id, receive (log) time, payload; little endian.
+std::string message_data_frame(uint32_t subscription, uint64_t log_time_ns, const std::string& payload);
+
+// What a client asked for, parsed from one text message.
+struct ClientRequest {
+  enum class Kind { kSubscribe, kUnsubscribe, kGetParameters, kSetParameters, kRefused, kUnknown };
+  Kind kind = Kind::kUnknown;
+  std::vector<std::pair<uint32_t, uint32_t>> subscriptions;  // (subscription id, channel id)
+  std::vector<uint32_t> unsubscriptions;                     // subscription ids
+  std::vector<std::string> parameter_names;                  // get: empty for all; set: the names to be set
+  std::string request_id;
+  std::string op;     // as sent
+  std::string error;  // why the message could not be read ("" when it could)
+};
+ClientRequest parse_client_request(const std::string& text);
+
+// The first subprotocol the client offered that the server speaks, if any.
+std::optional<std::string> choose_subprotocol(const std::vector<std::string>& offered);
+
+}  // namespace rigctl::foxglove

@@ -1,0 +1,98 @@
+// A Foxglove WebSocket protocol server (docs/foxglove.md): channels with JSON
+// schemas and JSON messages, status messages with ids, read-only parameters.
+// It knows nothing of rigs: the telemetry feed (foxglove/telemetry) decides
+// what is published. Clients may only listen: no client publishing, and
+// parameters cannot be set.
+//
+// Threads: publish(), add_channel(), set_status() and remove_status() may be
+// called from any thread and never wait for a client: each client has its
+// own bounded queue that drops its oldest message when full (and counts it);
+// the server's own thread moves messages from the queues onto the sockets
+// while the socket keeps up.
+//
+// This header is plain C++17 and includes no WebSocket library: websocketpp
+// 0.8 does not compile as C++20, so only server.cpp sees it.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace rigctl::foxglove {
+
+// The protocol's subprotocol names: clients of different generations ask for
+// one or the other, and the protocol is the same.
+inline constexpr const char* kSubprotocols[] = {"foxglove.websocket.v1", "foxglove.sdk.v1"};
+
+struct ServerOptions {
+  std::string address = "127.0.0.1";  // loopback unless the operator says otherwise
+  uint16_t port = 8765;               // 0: any free port (port() tells which)
+  // A client's queue in messages. 1024 is half a second of every channel at
+  // 400 Hz: a client further behind than that is shown fresh data rather
+  // than an ever older backlog (and the server's memory stays bounded).
+  std::size_t client_queue_messages = 1024;
+  std::string name = "rigctl";
+  std::map<std::string, std::string> metadata;  // serverInfo.metadata
+};
+
+enum class StatusLevel { kInfo = 0, kWarning = 1, kError = 2 };
+
+struct Parameter {
+  std::string name;
+  double value = 0.0;
+};
+
+struct ClientStats {
+  std::string address;     // peer address:port
+  std::string subprotocol;
+  int64_t sent = 0;        // messages written to the socket
+  int64_t dropped = 0;     // messages the client's full queue dropped (oldest first)
+};
+
+struct ServerStats {
+  int64_t clients = 0;     // connections accepted so far
+  int64_t sent = 0;
+  int64_t dropped = 0;
+  std::vector<ClientStats> per_client;  // every client seen, in order of connection
+};
+
+class Server {
+ public:
+  // Binds and listens; throws std::runtime_error naming address and port.
+  explicit Server(ServerOptions options);
+  ~Server();
+  Server(const Server&) = delete;
+  Server& operator=(const Server&) = delete;
+
+  void start();  // the server's thread
+  void stop();   // closes every connection, joins the thread (the destructor calls it)
+
+  uint16_t port() const;
+  const std::string& address() const;
+
+  // A channel of JSON messages with a JSON schema (schema encoding
+  // "jsonschema"); advertised to every client now and to each new one.
+  uint32_t add_channel(const std::string& topic, const std::string& schema_name, const std::string& schema);
+  bool has_subscribers(uint32_t channel) const;
+  // Queues the message for every client subscribed to the channel.
+  void publish(uint32_t channel, uint64_t log_time_ns, std::shared_ptr<const std::string> json);
+
+  // A status with an id stays active (and is sent to clients that connect
+  // later) until remove_status() sends removeStatus for it.
+  void set_status(const std::string& id, StatusLevel level, const std::string& message);
+  void remove_status(const std::string& id);
+
+  // Answered to getParameters; setParameters is refused (read-only).
+  void set_parameters(std::vector<Parameter> parameters);
+
+  ServerStats stats() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace rigctl::foxglove

@@ -1,0 +1,30 @@
+#include "foxglove/telemetry/telemetry_server.hpp"
+
+#include <sstream>
+
+namespace rigctl::foxglove {
+
+TelemetryServer::TelemetryServer(const ServerOptions& options, const std::string& channel_prefix,
+                                 std::vector<Parameter> parameters)
+    : server_(options), feed_(server_, channel_prefix) {
+  server_.set_parameters(std::move(parameters));
+}
+
+std::string TelemetryServer::url() const {
+  const std::string& a = server_.address();
+  const bool v6 = a.find(':') != std::string::npos;
+  return "ws://" + (v6 ? "[" + a + "]" : a) + ":" + std::to_string(server_.port());
+}
+
+std::string TelemetryServer::describe_clients() const {
+  const ServerStats s = stats();
+  std::ostringstream os;
+  os << s.clients << " client" << (s.clients == 1 ? "" : "s") << ", " << s.sent << " messages sent, " << s.dropped
+     << " dropped by slow clients (oldest first)";
+  for (const auto& c : s.per_client) {
+    os << "\n    " << c.address << " (" << c.subprotocol << "): " << c.sent << " sent, " << c.dropped << " dropped";
+  }
+  return os.str();
+}
+
+}  // namespace rigctl::foxglove
