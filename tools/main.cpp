@@ -11,6 +11,7 @@
 #include "tools/cmd/cmd_command.hpp"
 #include "tools/diagnosis/diagnose_command.hpp"
 #include "tools/hidden_effects/make_run.hpp"
+#include "tools/identify/identify_command.hpp"
 #include "tools/runfile/log2csv.hpp"
 #include "tools/runfile/run_file_rig.hpp"
 #include "tools/suspension/optimize_command.hpp"
@@ -136,6 +137,29 @@ int main(int argc, char** argv) {
   opcmd_cmd->add_option("--wait-ack", opcmd.wait_ack_s, "Seconds to wait for the rig's reply; 0: do not wait")->capture_default_str();
   opcmd_cmd->add_option("--state-file", opcmd.state_path, "Sequence state file (default $XDG_STATE_HOME/rigctl/<sender>.seq)");
 
+  // Commissioning (issue 18): the loop's frequency response (docs/frf-files.md).
+  rigctl::IdentifyOptions ident;
+  std::string ident_excitation;
+  std::vector<double> ident_band;
+  double ident_amplitude = 0, ident_duration = 0, ident_resolution = 0, ident_op = 0, ident_settle = 0, ident_gain = 0;
+  auto* ident_cmd = app.add_subcommand("identify", "Measure the loop's and the plant's frequency response with an excitation about an operating point (docs/frf-files.md)");
+  ident_cmd->add_option("config", ident.config_path, "Rig config (YAML); its optional identify: section sets the defaults")->required()->check(CLI::ExistingFile);
+  ident_cmd->add_option("--case", ident.case_name, "Apply a named variant from the config's `cases:`");
+  ident_cmd->add_option("--out", ident.out_path, "FRF file to write (JSON)")->required();
+  ident_cmd->add_option("--plot", ident.plot_path, "Also plot the FRF with its coherence (PNG; needs matplotlib: setup.sh --plots)");
+  ident_cmd->add_option("--log", ident.log_path, "LCM log of the run (default: a new file in the config's log_dir)");
+  ident_cmd->add_option("--csv", ident.csv_path, "Run file of the run (default: next to the FRF, -run.csv)");
+  ident_cmd->add_flag("--fast", ident.fast, "Simulated plant only: simulated time, as fast as the CPU allows");
+  ident_cmd->add_flag("--no-realtime{false}", ident.realtime, "Do not try mlockall/SCHED_FIFO");
+  auto* ex_opt = ident_cmd->add_option("--excitation", ident_excitation, "Excitation: " + rigctl::known_kind_names<rigctl::ExcitationKind>());
+  auto* band_opt = ident_cmd->add_option("--band", ident_band, "Band LOW HIGH [Hz]")->expected(2);
+  auto* amp_opt = ident_cmd->add_option("--amplitude", ident_amplitude, "Peak of the excitation [feedback unit]; clamped by the rig's limits (default: the clamp)")->check(CLI::PositiveNumber);
+  auto* dur_opt = ident_cmd->add_option("--duration", ident_duration, "Excitation time [s], the first (settling) segment included")->check(CLI::PositiveNumber);
+  auto* res_opt = ident_cmd->add_option("--resolution", ident_resolution, "Frequency resolution [Hz]: one Welch segment lasts 1/resolution")->check(CLI::PositiveNumber);
+  auto* op_opt = ident_cmd->add_option("--operating-point", ident_op, "Demand held while exciting [feedback unit] (default: mid-stroke, the middle of safety.setpoint_range)");
+  auto* settle_opt = ident_cmd->add_option("--settle", ident_settle, "Hold at the operating point before the excitation [s]")->check(CLI::NonNegativeNumber);
+  auto* gain_opt = ident_cmd->add_option("--stabiliser-gain", ident_gain, "Replace the controller by a proportional one of this gain (PI: kp, P+V+dP: Ke): a rig without gains")->check(CLI::PositiveNumber);
+
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -145,6 +169,22 @@ int main(int argc, char** argv) {
       install_stop_handlers();
       const auto report = rigctl::run_rig(run, g_stop, std::cout);
       return report.loop.final_state == rigctl::RigState::kFaulted ? 3 : 0;
+    }
+    if (ident_cmd->parsed()) {
+      auto& st = ident.settings;
+      if (ex_opt->count() > 0) st.excitation = rigctl::parse_kind<rigctl::ExcitationKind>(ident_excitation);
+      if (band_opt->count() > 0) {
+        st.band_min_hz = ident_band[0];
+        st.band_max_hz = ident_band[1];
+      }
+      if (amp_opt->count() > 0) st.amplitude = ident_amplitude;
+      if (dur_opt->count() > 0) st.duration_s = ident_duration;
+      if (res_opt->count() > 0) st.resolution_hz = ident_resolution;
+      if (op_opt->count() > 0) st.operating_point = ident_op;
+      if (settle_opt->count() > 0) st.settle_s = ident_settle;
+      if (gain_opt->count() > 0) st.stabiliser_gain = ident_gain;
+      install_stop_handlers();
+      return rigctl::run_identify(ident, g_stop, std::cout).aborted ? 3 : 0;
     }
     if (sim_cmd->parsed()) {
       if (sim_duration_opt->count() > 0) sim.duration_s = sim_duration;

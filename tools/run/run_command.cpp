@@ -62,6 +62,12 @@ RunReport run_rig(const RunOptions& options, const std::atomic<bool>& stop, std:
 
 RunReport run_rig(const RigConfig& config, const RunOptions& options, const std::atomic<bool>& stop, std::ostream& out) {
   AssembledRig rig = assemble_rig(config);
+  if (options.profile_override) {
+    auto raw = options.profile_override();
+    rig.profile_duration_s = raw->duration();
+    rig.profile = std::make_unique<FilteredProfile>(std::move(raw), 0.0, config.loop.period_s);
+  }
+  if (options.controller_override) rig.controller = options.controller_override(rig.driver->layout());
   if (options.fast && !rig.driver->simulated()) {
     throw std::runtime_error("--fast needs a simulated driver: '" + std::string(to_string(config.driver)) + "' runs real hardware in real time");
   }
@@ -209,14 +215,17 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
   report.loop = result;
 
   const auto& t = result.timing;
-  out << "  ended: " << to_string(result.final_state) << " (" << to_string(result.end_event.code);
+  std::ostringstream why;
+  why << to_string(result.end_event.code);
   if (result.end_event.channel >= 0) {
     // Valve saturation names an output; every other trip an input.
     const auto& channels =
         result.end_event.code == EventCode::kValveSaturated ? meta.layout.outputs : meta.layout.inputs;
     const auto index = static_cast<std::size_t>(result.end_event.channel);
-    out << ": " << (index < channels.size() ? channels[index].name : "?") << " = " << result.end_event.value;
+    why << ": " << (index < channels.size() ? channels[index].name : "?") << " = " << result.end_event.value;
   }
+  report.end_reason = why.str();
+  out << "  ended: " << to_string(result.final_state) << " (" << report.end_reason;
   out << ") after " << result.ticks << " ticks ("
       << std::fixed << std::setprecision(3) << static_cast<double>(result.ticks) * config.loop.period_s
       << " s rig time, " << report.wall_s << " s wall), rig state " << to_string(result.final_safety_state) << "\n";

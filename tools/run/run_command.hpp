@@ -3,6 +3,8 @@
 #pragma once
 
 #include <atomic>
+#include <functional>
+#include <memory>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -11,6 +13,9 @@
 #include "config/rig_config.hpp"
 #include "rt/loop/rig_loop.hpp"
 #include "drivers/sim/fault_spec.hpp"
+#include "rt/control/controller.hpp"
+#include "rt/control/setpoint_profile.hpp"
+#include "rt/sample.hpp"
 
 namespace rigctl {
 
@@ -36,6 +41,14 @@ struct RunOptions {
   std::string key_path;        // --key: overrides operator.key_file
   // --fault KIND@TIME[:ARG...], after the config's `faults:`; simulated driver only (drivers/sim/sim_faults.hpp).
   std::vector<FaultSpec> faults;
+  // Parts that replace the config's, for the commissioning commands
+  // (rigctl identify, rigctl tune --method relay): the demand (an excitation
+  // about an operating point, applied unfiltered; its length is the run's
+  // default length) and the controller (a relay experiment), built for the
+  // assembled rig's channels. Everything else, the safety machinery above
+  // all, is the config's.
+  std::function<std::unique_ptr<SetpointProfile>()> profile_override;
+  std::function<std::unique_ptr<Controller>(const ChannelLayout&)> controller_override;
 };
 
 struct RunReport {
@@ -43,6 +56,7 @@ struct RunReport {
   std::string log_path;
   std::string csv_path;
   std::string events_path;
+  std::string end_reason;  // why the run ended, e.g. "sensor_stuck: x_r = 0.0348"
   double wall_s = 0.0;
 };
 
