@@ -12,6 +12,7 @@
 #include "tools/diagnosis/diagnose_command.hpp"
 #include "tools/hidden_effects/make_run.hpp"
 #include "tools/identify/identify_command.hpp"
+#include "tools/tune/tune_command.hpp"
 #include "tools/runfile/log2csv.hpp"
 #include "tools/runfile/run_file_rig.hpp"
 #include "tools/suspension/optimize_command.hpp"
@@ -160,6 +161,26 @@ int main(int argc, char** argv) {
   auto* settle_opt = ident_cmd->add_option("--settle", ident_settle, "Hold at the operating point before the excitation [s]")->check(CLI::NonNegativeNumber);
   auto* gain_opt = ident_cmd->add_option("--stabiliser-gain", ident_gain, "Replace the controller by a proportional one of this gain (PI: kp, P+V+dP: Ke): a rig without gains")->check(CLI::PositiveNumber);
 
+  rigctl::TuneOptions tune;
+  std::string tune_method = "frf";
+  double tune_bandwidth = 0;
+  auto* tune_cmd = app.add_subcommand("tune", "Gains for the rig's controller from a measured FRF (or a relay experiment), with predicted margins and step (docs/frf-files.md)");
+  tune_cmd->add_option("config", tune.config_path, "Rig config (YAML)")->required()->check(CLI::ExistingFile);
+  tune_cmd->add_option("--case", tune.case_name, "Apply a named variant from the config's `cases:`");
+  tune_cmd->add_option("--frf", tune.frf_path, "FRF file from rigctl identify")->check(CLI::ExistingFile);
+  tune_cmd->add_option("--method", tune_method, "frf: loop shaping on the FRF; relay: Astrom-Hagglund relay experiment, Ziegler-Nichols gains")->check(CLI::IsMember({"frf", "relay"}));
+  tune_cmd->add_option("--phase-margin", tune.target.phase_margin_deg, "Target phase margin [deg]")->capture_default_str()->check(CLI::Range(10.0, 89.0));
+  auto* bw_opt = tune_cmd->add_option("--bandwidth", tune_bandwidth, "Target crossover frequency [Hz] (default: the stiffest design with 6 dB gain margin and sensitivity peak 2)")->check(CLI::PositiveNumber);
+  tune_cmd->add_option("--out", tune.out_path, "Write the config with the tuned gains (YAML, comments kept)");
+  tune_cmd->add_option("--json", tune.json_path, "Write the design and its predictions (JSON)");
+  tune_cmd->add_option("--plot", tune.plot_path, "Bode plot of the measured plant and the tuned loop (PNG)");
+  tune_cmd->add_option("--relay-amplitude", tune.relay.amplitude, "Relay output about the hold command [command unit] (default: a tenth of the output limit)")->check(CLI::PositiveNumber);
+  tune_cmd->add_option("--relay-hysteresis", tune.relay.hysteresis, "Relay hysteresis [feedback unit] (default: 3 x the sensor noise)")->check(CLI::PositiveNumber);
+  tune_cmd->add_option("--relay-duration", tune.relay.duration_s, "Relay time [s]")->capture_default_str()->check(CLI::PositiveNumber);
+  tune_cmd->add_option("--log", tune.relay.log_path, "LCM log of the relay run");
+  tune_cmd->add_flag("--fast", tune.relay.fast, "Relay on a simulated plant: simulated time");
+  tune_cmd->add_flag("--no-realtime{false}", tune.relay.realtime, "Do not try mlockall/SCHED_FIFO");
+
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -185,6 +206,13 @@ int main(int argc, char** argv) {
       if (gain_opt->count() > 0) st.stabiliser_gain = ident_gain;
       install_stop_handlers();
       return rigctl::run_identify(ident, g_stop, std::cout).aborted ? 3 : 0;
+    }
+    if (tune_cmd->parsed()) {
+      tune.method = rigctl::parse_kind<rigctl::TuneMethod>(tune_method);
+      if (bw_opt->count() > 0) tune.target.crossover_hz = tune_bandwidth;
+      install_stop_handlers();
+      rigctl::run_tune(tune, g_stop, std::cout);
+      return 0;
     }
     if (sim_cmd->parsed()) {
       if (sim_duration_opt->count() > 0) sim.duration_s = sim_duration;

@@ -34,13 +34,13 @@ void every_trip_interlocks(SafetyConfig& s) {
   for (auto& d : s.detectors) d.action = LimitAction::kInterlock;
 }
 
+}  // namespace
+
 double default_operating_point(const RigConfig& c) {
   const auto& s = c.safety;
   if (std::isfinite(s.setpoint_min) && std::isfinite(s.setpoint_max)) return 0.5 * (s.setpoint_min + s.setpoint_max);
   return c.profile.ramp_target;
 }
-
-}  // namespace
 
 std::map<std::string, double> controller_gains(const ControllerConfig& c) {
   switch (c.type) {

@@ -42,6 +42,10 @@ struct IdentifyPlan {
 // (pi, pvp) or an operating point outside the setpoint range.
 IdentifyPlan plan_identification(RigConfig config, const IdentifySettings& settings);
 
+// The default operating point: the middle of safety.setpoint_range
+// (mid-stroke), else the profile's ramp target.
+double default_operating_point(const RigConfig& config);
+
 // The controller's gains by their config keys (config units), as the FRF
 // file and the tuned config carry them.
 std::map<std::string, double> controller_gains(const ControllerConfig& controller);

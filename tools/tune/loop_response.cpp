@@ -1,0 +1,72 @@
+#include "tools/tune/loop_response.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+namespace rigctl {
+
+namespace {
+
+Complex z_inverse(double f_hz, double period_s) { return std::polar(1.0, -2.0 * std::numbers::pi * f_hz * period_s); }
+
+}  // namespace
+
+PlantResponse PlantResponse::from_frf(const FrfData& frf) {
+  PlantResponse p;
+  p.frequency_hz = frf.frequency_hz;
+  const FrfCurve& pos = frf.plant_of(frf.responses.at(0).name);
+  p.position = pos.value;
+  p.coherence = pos.coherence;
+  if (frf.responses.size() > 1) {
+    const FrfCurve& pr = frf.plant_of(frf.responses[1].name);
+    p.pressure = pr.value;
+    for (std::size_t i = 0; i < p.coherence.size(); ++i) p.coherence[i] = std::min(p.coherence[i], pr.coherence[i]);
+  }
+  return p;
+}
+
+Complex pi_path(const LoopGains& g, double f_hz) {
+  return g.kp + g.ki * g.period_s / (1.0 - z_inverse(f_hz, g.period_s));
+}
+
+Complex velocity_estimate(const LoopGains& g, double f_hz) {
+  const double tau = g.velocity_filter_tau_s;
+  const double alpha = tau > 0.0 ? 1.0 - std::exp(-g.period_s / tau) : 1.0;
+  const Complex zi = z_inverse(f_hz, g.period_s);
+  return alpha * (1.0 - zi) / g.period_s / (1.0 - (1.0 - alpha) * zi);
+}
+
+Complex pressure_path(const LoopGains& g, double f_hz) {
+  if (!g.transient_pressure) return 1.0;
+  const double a = g.transient_tau_s / (g.transient_tau_s + g.period_s);
+  const Complex zi = z_inverse(f_hz, g.period_s);
+  return a * (1.0 - zi) / (1.0 - a * zi);
+}
+
+Complex loop_transfer_at(const LoopGains& g, double f, Complex position, Complex pressure) {
+  switch (g.kind) {
+    case ControllerKind::kPi: return pi_path(g, f) * position;
+    case ControllerKind::kPvp:
+      return (g.ke + g.kv * velocity_estimate(g, f)) * position + g.kp_pressure * pressure_path(g, f) * pressure;
+    case ControllerKind::kPassive:
+    case ControllerKind::kFuzzy:
+    case ControllerKind::kSkyhook:
+    case ControllerKind::kLqr: break;
+  }
+  throw std::invalid_argument("loop_transfer: not a position controller");
+}
+
+std::vector<Complex> loop_transfer(const LoopGains& g, const PlantResponse& p) {
+  if (g.kind == ControllerKind::kPvp && p.pressure.size() != p.position.size()) {
+    throw std::invalid_argument("P+V+dP needs the plant's pressure response in the FRF");
+  }
+  std::vector<Complex> out;
+  for (std::size_t i = 0; i < p.frequency_hz.size(); ++i) {
+    out.push_back(loop_transfer_at(g, p.frequency_hz[i], p.position[i], p.pressure.empty() ? Complex{} : p.pressure[i]));
+  }
+  return out;
+}
+
+}  // namespace rigctl
