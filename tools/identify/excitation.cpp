@@ -38,11 +38,26 @@ std::pair<std::size_t, std::size_t> band_bins(const ExcitationSpec& s, std::size
   return {std::max<std::size_t>(lo, 1), hi};
 }
 
-// The odd bins of the band.
-std::vector<std::size_t> odd_lines(const ExcitationSpec& s, std::size_t n) {
+// A random-odd grid: the odd bins of the band, one in each group of three
+// left out at random (never the band's first, which sets its low end). The
+// rig's even-order distortion falls on the even bins, its odd-order
+// distortion (friction, hysteresis) partly on the odd bins left out: both
+// are seen beside the lines, where noise alone would put much less.
+std::vector<std::size_t> random_odd_lines(const ExcitationSpec& s, std::size_t n) {
   const auto [lo, hi] = band_bins(s, n);
+  std::vector<std::size_t> odd;
+  for (std::size_t k = lo | 1U; k <= hi; k += 2) odd.push_back(k);
+  std::mt19937_64 rng(s.seed);
   std::vector<std::size_t> out;
-  for (std::size_t k = lo | 1U; k <= hi; k += 2) out.push_back(k);
+  for (std::size_t g = 0; g < odd.size(); g += 3) {
+    const std::size_t size = std::min<std::size_t>(3, odd.size() - g);
+    // The first group keeps its first bin; a group of one keeps it.
+    const std::size_t first = g == 0 ? 1 : 0;
+    const std::size_t skip = size > first + 1 ? first + rng() % (size - first) : size;
+    for (std::size_t i = 0; i < size; ++i) {
+      if (i != skip) out.push_back(odd[g + i]);
+    }
+  }
   return out;
 }
 
@@ -120,7 +135,7 @@ Excitation make_excitation(const ExcitationSpec& s) {
     case ExcitationKind::kMultisine:
     case ExcitationKind::kChirp: {
       e.periodic = true;
-      if (s.kind == ExcitationKind::kMultisine) e.lines = odd_lines(s, e.segment_ticks);
+      if (s.kind == ExcitationKind::kMultisine) e.lines = random_odd_lines(s, e.segment_ticks);
       if (s.kind == ExcitationKind::kMultisine && e.lines.empty()) {
         throw std::invalid_argument("excitation band holds no odd bin at resolution " + std::to_string(s.resolution_hz) + " Hz");
       }

@@ -1,13 +1,17 @@
 // The band-limited signals `rigctl identify` adds to the demand. Each is a
 // table of one value per control tick, its peak exactly the requested
 // amplitude, its power inside the band: lines (multisine), a sweep (chirp)
-// or noise with 1/f power (pink). The multisine excites only the odd bins of
-// a segment: the second-order distortion of the rig (the valve's square-root
-// orifice law, the asymmetric cylinder) falls on the even bins, where it
-// cannot bias the response; with every bin excited it biased the quarter
-// car's plant FRF by about 1 dB per millimetre of excitation at 0.5 Hz. The periodic ones repeat every Welch
-// segment, so the estimate averages whole periods with a rectangular window
-// and has no leakage; pink noise is averaged with Hann windows.
+// or noise with 1/f power (pink). The multisine is a random-odd one: only
+// odd bins of a segment, one in three of them left out. The second-order
+// distortion of the rig (the valve's square-root orifice law, the asymmetric
+// cylinder) falls on the even bins, where it cannot bias the response (with
+// every bin excited it biased the quarter car's plant FRF by about 1 dB per
+// millimetre of excitation at 0.5 Hz), and the bins left out show the
+// odd-order distortion (friction, hysteresis) that no coherence reveals: a
+// periodic excitation of a nonlinear rig gives a periodic, fully coherent,
+// response. The periodic kinds repeat every Welch segment, so the estimate
+// averages whole periods with a rectangular window and has no leakage; pink
+// noise is averaged with Hann windows.
 #pragma once
 
 #include <cstddef>

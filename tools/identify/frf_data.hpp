@@ -72,6 +72,12 @@ struct FrfData {
   // (1 - coherence with the demand) x auto-spectrum [unit^2 / Hz].
   std::map<std::string, std::vector<double>> noise_floor;
   std::map<std::string, std::vector<double>> response_psd;  // auto-spectra, same units
+  // Multisine only: each response's mean power on the non-excited bins
+  // within three of a line over its power on the line. The rig's nonlinearity
+  // (friction, hysteresis, the valve's edges) puts power there that noise
+  // alone would not (the noise floor is the same on both): a line where
+  // this ratio is not small measured a nonlinear response, however coherent.
+  std::map<std::string, std::vector<double>> distortion;
   std::vector<FrfCurve> model;  // optional: the simulated plant's linearisation, command -> response
 
   const FrfCurve& plant_of(const std::string& response) const;

@@ -12,6 +12,18 @@ double coherence(const CrossSpectra& s, std::size_t k, int i, int j) {
   return denom > 0.0 ? std::norm(s.at(k, i, j)) / denom : 0.0;
 }
 
+// Mean power on the bins within three of line k that were not excited.
+double power_beside(const CrossSpectra& s, const std::vector<std::size_t>& lines, std::size_t k, int y) {
+  double sum = 0.0;
+  int count = 0;
+  for (std::size_t j = k > 3 ? k - 3 : 1; j <= k + 3 && j < s.frequency_hz.size(); ++j) {
+    if (std::find(lines.begin(), lines.end(), j) != lines.end()) continue;
+    sum += s.power(j, y);
+    ++count;
+  }
+  return count > 0 ? sum / count : 0.0;
+}
+
 }  // namespace
 
 void estimate_frf(const IdentificationRecord& r, const WelchSettings& settings, double band_min_hz,
@@ -27,6 +39,7 @@ void estimate_frf(const IdentificationRecord& r, const WelchSettings& settings, 
   out.plant.assign(r.responses.size(), {});
   out.noise_floor.clear();
   out.response_psd.clear();
+  out.distortion.clear();
   for (std::size_t c = 0; c < r.responses.size(); ++c) {
     out.closed_loop[c].response = out.plant[c].response = out.responses.at(c).name;
   }
@@ -50,6 +63,7 @@ void estimate_frf(const IdentificationRecord& r, const WelchSettings& settings, 
       out.plant[c].coherence.push_back(std::min(g_ry, g_ru));
       out.noise_floor[out.responses[c].name].push_back((1.0 - g_ry) * s.power(k, y));
       out.response_psd[out.responses[c].name].push_back(s.power(k, y));
+      if (!bins.empty()) out.distortion[out.responses[c].name].push_back(power_beside(s, bins, k, y) / s.power(k, y));
     }
   }
   if (out.frequency_hz.empty()) throw std::invalid_argument("no frequency bin inside the band");

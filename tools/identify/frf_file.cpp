@@ -84,6 +84,7 @@ std::string frf_to_json(const FrfData& f) {
     << "  \"command_coherence\": " << numbers(f.command_coherence) << ",\n"
     << "  \"noise_floor\": " << series_map(f.noise_floor) << ",\n"
     << "  \"response_psd\": " << series_map(f.response_psd);
+  if (!f.distortion.empty()) o << ",\n  \"distortion\": " << series_map(f.distortion);
   if (!f.model.empty()) o << ",\n  \"model\": " << curves(f.model);
   o << "\n}\n";
   return o.str();
@@ -224,6 +225,9 @@ FrfData parse_frf_json(const std::string& text, const std::string& name) {
   f.noise_floor[f.command.name] = r.series(r.need(root, "noise_floor", ""), f.command.name, "noise_floor.", n);
   for (const auto& c : f.responses) f.response_psd[c.name] = r.series(r.need(root, "response_psd", ""), c.name, "response_psd.", n);
   f.response_psd[f.command.name] = r.series(r.need(root, "response_psd", ""), f.command.name, "response_psd.", n);
+  if (root["distortion"]) {
+    for (const auto& c : f.responses) f.distortion[c.name] = r.series(root["distortion"], c.name, "distortion.", n);
+  }
   if (root["model"]) f.model = r.curves(root, "model", f.responses, n, false);
   return f;
 }

@@ -24,22 +24,41 @@ std::optional<LoopGains> pi_at(const PlantGrid& p, LoopGains g, const DesignTarg
   return g;
 }
 
-// Ke a + Kv b + Kp c = L for a given Kp: two real equations for Ke and Kv.
-std::optional<LoopGains> pvp_at(const PlantGrid& p, LoopGains g, const DesignTarget& t, double fc, double kp) {
-  const Complex a = p.position(fc);
-  const Complex b = velocity_estimate(g, fc) * a;
-  const Complex c = pressure_path(g, fc) * p.pressure(fc);
-  const Complex rhs = target_loop(t) - kp * c;
-  const double det = a.real() * b.imag() - a.imag() * b.real();
-  if (std::abs(det) < 1e-300) return std::nullopt;
-  g.ke = (rhs.real() * b.imag() - rhs.imag() * b.real()) / det;
-  g.kv = (a.real() * rhs.imag() - a.imag() * rhs.real()) / det;
-  g.kp_pressure = kp;
-  if (!(g.ke > 0.0 && g.kv >= 0.0)) return std::nullopt;
-  return g;
+// With the inner loop (Kv, Kp) fixed, the position loop is Ke M, M = G / (1
+// + inner): Ke puts |L| = 1 where the angle of M is -180 + PM. Every such
+// crossover in the band is a candidate (the first one above the lowest
+// frequency where the phase reaches the line).
+std::vector<LoopGains> pvp_with_inner(const PlantGrid& p, LoopGains g, const DesignTarget& t, const std::vector<double>& f) {
+  std::vector<LoopGains> out;
+  g.ke = 1.0;
+  const auto m = p.loop(g, f);
+  const auto phase = unwrapped_phase_deg(m);
+  const double line = t.phase_margin_deg - 180.0;
+  for (std::size_t i = 0; i + 1 < f.size(); ++i) {
+    if ((phase[i] - line) * (phase[i + 1] - line) > 0.0 || phase[i] == phase[i + 1]) continue;
+    const double u = (line - phase[i]) / (phase[i + 1] - phase[i]);
+    const double fc = std::exp(std::log(f[i]) + u * (std::log(f[i + 1]) - std::log(f[i])));
+    g.ke = 1.0 / std::abs(loop_transfer_at(g.with_ke(1.0), fc, p.position(fc), p.pressure(fc)));
+    out.push_back(g);
+    g.ke = 1.0;
+  }
+  return out;
 }
 
-double stiffness(const LoopGains& g) { return g.kind == ControllerKind::kPi ? g.ki : g.ke; }
+double stiffness(const LoopGains& g, const PlantGrid& p) {
+  if (g.kind == ControllerKind::kPi) return g.ki;
+  const double f = p.f_min();
+  const double k = (Complex(0.0, 2.0 * std::numbers::pi * f) * p.position(f)).real();
+  const double p0 = p.pressure(f).real();
+  return g.ke * k / (1.0 + g.kv * k + g.kp_pressure * p0);
+}
+
+// The inner loop's own sensitivity peak (1 for PI, which has none).
+double inner_sensitivity(const PlantGrid& p, const LoopGains& g) {
+  double peak = 1.0;
+  for (const auto& z : p.inner_loop(g, p.log_grid(kMarginPoints))) peak = std::max(peak, 1.0 / std::abs(1.0 + z));
+  return peak;
+}
 
 LoopDesign judge(const PlantGrid& p, const LoopGains& g, const DesignTarget& t, double fc) {
   LoopDesign d{g, margins_of(p, g), true, ""};
@@ -50,25 +69,39 @@ LoopDesign judge(const PlantGrid& p, const LoopGains& g, const DesignTarget& t, 
   } else if (m.gain_margin_db < t.min_gain_margin_db) {
     d.meets_target = false;
     d.note = "gain margin below " + std::to_string(t.min_gain_margin_db) + " dB";
-  } else if (m.peak_sensitivity > t.max_sensitivity) {
+  } else if ((g.kind == ControllerKind::kPi ? g.kp : g.ke) > t.max_demand_gain) {
+    d.meets_target = false;
+    d.note = "demand gain above " + std::to_string(t.max_demand_gain) + ": the unfiltered step would saturate the valve";
+  } else if (m.peak_sensitivity > t.max_sensitivity || inner_sensitivity(p, g) > t.max_sensitivity) {
     d.meets_target = false;
     d.note = "sensitivity peak above " + std::to_string(t.max_sensitivity);
   }
   return d;
 }
 
-// Every candidate gain set at one crossover.
-std::vector<LoopGains> candidates_at(const PlantGrid& p, const LoopGains& base, const DesignTarget& t, double fc) {
-  std::vector<LoopGains> out;
+// Every candidate gain set: PI at each crossover; P+V+dP over a grid of
+// inner loops (Kv from none to 100 V s/rad, Kp from none to 1e-3 V/Pa, i.e.
+// 100 V/bar: beyond any use), each at the crossovers its phase allows.
+std::vector<std::pair<LoopGains, double>> candidates(const PlantGrid& p, const LoopGains& base, const DesignTarget& t,
+                                                     const std::vector<double>& crossovers) {
+  std::vector<std::pair<LoopGains, double>> out;
   if (base.kind == ControllerKind::kPi) {
-    if (auto g = pi_at(p, base, t, fc)) out.push_back(*g);
+    for (double fc : crossovers) {
+      if (auto g = pi_at(p, base, t, fc)) out.emplace_back(*g, fc);
+    }
     return out;
   }
-  // Pressure gains from none up to 1e-3 V/Pa (100 V/bar, far beyond any use).
-  out.reserve(41);
-  for (int i = -1; i < 40; ++i) {
-    const double kp = i < 0 ? 0.0 : 1e-8 * std::pow(10.0, 5.0 * i / 39.0);
-    if (auto g = pvp_at(p, base, t, fc, kp)) out.push_back(*g);
+  const auto f = p.log_grid(kMarginPoints);
+  for (int i = -1; i < 30; ++i) {
+    for (int j = -1; j < 20; ++j) {
+      LoopGains g = base;
+      g.kv = i < 0 ? 0.0 : 1e-3 * std::pow(10.0, 5.0 * i / 29.0);
+      g.kp_pressure = j < 0 ? 0.0 : 1e-8 * std::pow(10.0, 5.0 * j / 19.0);
+      for (const LoopGains& c : pvp_with_inner(p, g, t, f)) {
+        const double fc = margins_of(p, c).crossover_hz;
+        if (!t.crossover_hz || std::abs(fc - *t.crossover_hz) <= 0.05 * *t.crossover_hz) out.emplace_back(c, fc);
+      }
+    }
   }
   return out;
 }
@@ -84,15 +117,13 @@ LoopDesign design_loop(const PlantGrid& p, const LoopGains& base, const DesignTa
   if (base.kind == ControllerKind::kPvp && !p.has_pressure()) {
     throw std::runtime_error("P+V+dP tuning needs the plant's pressure response: identify with the pvp controller");
   }
-  std::vector<double> crossovers = t.crossover_hz ? std::vector<double>{*t.crossover_hz} : p.log_grid(kCrossoverPoints);
+  const std::vector<double> crossovers = t.crossover_hz ? std::vector<double>{*t.crossover_hz} : p.log_grid(kCrossoverPoints);
   std::optional<LoopDesign> best, closest;
-  for (double fc : crossovers) {
+  for (const auto& [g, fc] : candidates(p, base, t, crossovers)) {
     if (fc < p.f_min() || fc > p.f_max()) continue;
-    for (const LoopGains& g : candidates_at(p, base, t, fc)) {
-      LoopDesign d = judge(p, g, t, fc);
-      if (d.meets_target && (!best || stiffness(d.gains) > stiffness(best->gains))) best = d;
-      if (!closest) closest = d;
-    }
+    LoopDesign d = judge(p, g, t, fc);
+    if (d.meets_target && (!best || stiffness(d.gains, p) > stiffness(best->gains, p))) best = d;
+    if (!closest) closest = d;
   }
   if (best) return *best;
   if (t.crossover_hz && closest) return *closest;  // as asked, with the reason it falls short

@@ -2,13 +2,14 @@
 // With the crossover given (--bandwidth) the gains put L(j w_c) exactly at
 // |L| = 1, angle -180 + PM. Without it every crossover over the coherent
 // band is tried and the design with the largest low-frequency gain is kept
-// (the integral gain ki for PI, the stiffness Ke for P+V+dP: the smallest
-// error against leakage, friction and hysteresis) among those that also
+// (the integral gain ki for PI, the outer loop's velocity constant for
+// P+V+dP: the smallest tracking error) among those that also
 // keep a gain margin of at least 6 dB and a sensitivity peak of at most 2
 // (6 dB) on the measured plant: a maximum-stiffness design under robustness
 // constraints, in the manner of Astrom and Hagglund's MIGO.
 #pragma once
 
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -22,6 +23,10 @@ struct DesignTarget {
   std::optional<double> crossover_hz;  // --bandwidth
   double min_gain_margin_db = 6.0;     // classical minimum
   double max_sensitivity = 2.0;        // Ms <= 2: at most 6 dB of disturbance amplification
+  // Upper bound on the gain from demand to command (PI kp, P+V+dP Ke): an
+  // unfiltered step puts its whole size on the error at once, and a linear
+  // design holds only while that does not saturate the valve.
+  double max_demand_gain = std::numeric_limits<double>::infinity();
 };
 
 struct LoopDesign {

@@ -23,6 +23,11 @@ struct LoopGains {
   double velocity_filter_tau_s = 0.01;
 
   static LoopGains from_config(const RigConfig& config);
+  LoopGains with_ke(double value) const {
+    LoopGains g = *this;
+    g.ke = value;
+    return g;
+  }
   // The controller section's gain keys and values in the config's units
   // (kp_v_per_bar in V/bar): what a tuned config changes.
   std::map<std::string, double> config_values() const;

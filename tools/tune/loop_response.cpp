@@ -45,17 +45,27 @@ Complex pressure_path(const LoopGains& g, double f_hz) {
   return a * (1.0 - zi) / (1.0 - a * zi);
 }
 
+Complex inner_loop_at(const LoopGains& g, double f, Complex position, Complex pressure) {
+  if (g.kind != ControllerKind::kPvp) return 0.0;
+  return g.kv * velocity_estimate(g, f) * position + g.kp_pressure * pressure_path(g, f) * pressure;
+}
+
 Complex loop_transfer_at(const LoopGains& g, double f, Complex position, Complex pressure) {
   switch (g.kind) {
     case ControllerKind::kPi: return pi_path(g, f) * position;
-    case ControllerKind::kPvp:
-      return (g.ke + g.kv * velocity_estimate(g, f)) * position + g.kp_pressure * pressure_path(g, f) * pressure;
+    case ControllerKind::kPvp: return g.ke * position / (1.0 + inner_loop_at(g, f, position, pressure));
     case ControllerKind::kPassive:
     case ControllerKind::kFuzzy:
     case ControllerKind::kSkyhook:
     case ControllerKind::kLqr: break;
   }
   throw std::invalid_argument("loop_transfer: not a position controller");
+}
+
+std::vector<Complex> loop_from_closed_loop(const std::vector<Complex>& t) {
+  std::vector<Complex> out;
+  for (const auto& z : t) out.push_back(z / (1.0 - z));
+  return out;
 }
 
 std::vector<Complex> loop_transfer(const LoopGains& g, const PlantResponse& p) {

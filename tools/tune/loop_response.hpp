@@ -1,9 +1,11 @@
 // The loop as the controller closes it, from the measured plant FRF: each
-// feedback path of the controller in its discrete form (the code in
-// rt/control/ written as transfer functions in z = exp(j w Ts)), and the
-// loop transfer broken at the plant input (the valve command), L = sum of
-// path x plant, so that the closed loop's characteristic equation is 1 + L.
-// For PI, L = C G is also the loop broken at the error: the two coincide.
+// path of the controller in its discrete form (the code in rt/control/
+// written as transfer functions in z = exp(j w Ts)), and the position loop
+// broken at the error, L = C_demand G / (1 + inner), where the inner loop is
+// what feeds back besides the position error (P+V+dP: Kv omega and Kp dp;
+// PI: nothing). The closed loop demand -> position is L / (1 + L), so L is
+// also T / (1 - T) of a measured closed-loop FRF. The inner loop must be
+// stable and robust on its own: its margins are checked too.
 #pragma once
 
 #include <complex>
@@ -31,8 +33,12 @@ Complex pi_path(const LoopGains& g, double f_hz);                 // kp + ki Ts 
 Complex velocity_estimate(const LoopGains& g, double f_hz);       // omega / theta of the P+V+dP's filtered difference
 Complex pressure_path(const LoopGains& g, double f_hz);           // 1, or the high-pass of eq. 18
 
-// The loop transfer at the plant input on the plant's frequencies.
+// The position loop on the plant's frequencies.
 std::vector<Complex> loop_transfer(const LoopGains& g, const PlantResponse& plant);
 Complex loop_transfer_at(const LoopGains& g, double f_hz, Complex position, Complex pressure);
+// The inner loop at the plant input (0 for PI).
+Complex inner_loop_at(const LoopGains& g, double f_hz, Complex position, Complex pressure);
+// The position loop measured from a closed-loop FRF: T / (1 - T).
+std::vector<Complex> loop_from_closed_loop(const std::vector<Complex>& t);
 
 }  // namespace rigctl

@@ -1,30 +1,38 @@
-// A discrete transfer function fitted to the measured plant FRF, for
-// predicting the step response of a design in time (margins come from the
+// A continuous transfer function fitted to the measured plant FRF, for
+// predicting a design's step response in time (margins come from the
 // measurement itself, not from this model):
-//   position(z) = B_y(z^-1) / ((1 - z^-1) A(z^-1))      (the rigs' plants integrate)
-//   pressure(z) = B_p(z^-1) / A(z^-1)
-// with A = 1 + a_1 z^-1 + ... and every B starting at z^-1 (a command acts
-// from the next sample on). Sanathanan-Koerner iterations of Levy's linear
-// least squares, weighted by coherence; the lowest order of A that fits the
-// coherent points within 1 dB rms (and is stable) is kept.
+//   position(s) = N_y(x) / D(x),  pressure(s) = N_p(x) / D(x),  x = s / w0
+// (a common denominator: one plant; a pole at the origin within the fitting
+// noise is allowed, the rigs' plants integrate), D = 1 + d_1 x + ...,
+// fitted to the FRF with the sampling's half-period delay removed, by
+// Sanathanan-Koerner iterations of Levy's linear least squares weighted by
+// coherence (w0, the band's geometric centre, keeps the powers of x of one
+// size). The lowest order of D that fits within 1 dB rms and is stable is
+// kept; the model is then discretised with the DAC's zero-order hold, so it
+// samples as the loop does (tools/identify/plant_linearisation.hpp).
 #pragma once
 
 #include <vector>
+
+#include <Eigen/Core>
 
 #include "tools/tune/loop_response.hpp"
 
 namespace rigctl {
 
 struct PlantModel {
-  std::vector<double> a;                    // A without its leading 1
-  std::vector<double> b_position, b_pressure;
-  double rms_error_db = 0.0;                // of the position fit over the coherent points
-  bool has_pressure() const { return !b_pressure.empty(); }
+  std::vector<double> d, n_position, n_pressure;  // D without its leading 1, numerators from x^0
+  double w0 = 1.0;
+  double rms_error_db = 0.0;  // of the position fit over the coherent points
+  // Zero-order-hold discretisation: x_{k+1} = phi x_k + gamma u_k, y_k = c x_k
+  // (row 0 position, row 1 pressure when fitted).
+  Eigen::MatrixXd phi, gamma, c;
+  bool has_pressure() const { return !n_pressure.empty(); }
 };
 
 PlantModel fit_plant(const PlantResponse& measured, double period_s);
 
-// The model's FRF at f (for checks and plots).
-Complex model_position(const PlantModel& m, double f_hz, double period_s);
+// The continuous model's position FRF at f (for checks and plots).
+Complex model_position(const PlantModel& m, double f_hz);
 
 }  // namespace rigctl

@@ -54,4 +54,10 @@ std::vector<Complex> PlantGrid::loop(const LoopGains& g, const std::vector<doubl
   return out;
 }
 
+std::vector<Complex> PlantGrid::inner_loop(const LoopGains& g, const std::vector<double>& f_hz) const {
+  std::vector<Complex> out;
+  for (double f : f_hz) out.push_back(inner_loop_at(g, f, position(f), pressure(f)));
+  return out;
+}
+
 }  // namespace rigctl

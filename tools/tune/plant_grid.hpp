@@ -24,6 +24,7 @@ class PlantGrid {
   std::vector<double> log_grid(std::size_t points) const;
   // The loop transfer of `gains` on that grid.
   std::vector<Complex> loop(const LoopGains& gains, const std::vector<double>& f_hz) const;
+  std::vector<Complex> inner_loop(const LoopGains& gains, const std::vector<double>& f_hz) const;
 
  private:
   Complex at(double f, const std::vector<double>& db, const std::vector<double>& deg) const;

@@ -68,7 +68,11 @@ TuneResult run_tune(const TuneOptions& o, const std::atomic<bool>& stop, std::os
     const PlantGrid grid(plant);
     result.present_margins = margins_of(grid, gains_of_frf(*frf, base));
     if (o.method == TuneMethod::kFrf) {
-      const LoopDesign d = design_loop(grid, base, o.target);
+      DesignTarget target = o.target;
+      if (config.profile.type == ProfileKind::kRampSteps && config.profile.filter_tau_s == 0.0) {
+        target.max_demand_gain = base.output_limit / std::abs(standard_step(config).step);
+      }
+      const LoopDesign d = design_loop(grid, base, target);
       result.gains = d.gains;
       result.note = d.note;
     }

@@ -92,8 +92,9 @@ void write_tune_json(const TuneReportInput& in, const std::string& path) {
       << ", \"response\": " << numbers(r.step->response, 4) << "}";
   }
   if (in.model) {
-    o << ",\n  \"plant_model\": {\"a\": " << numbers(in.model->a) << ", \"b_position\": " << numbers(in.model->b_position)
-      << ", \"b_pressure\": " << numbers(in.model->b_pressure) << ", \"rms_error_db\": " << json_number(in.model->rms_error_db) << "}";
+    o << ",\n  \"plant_model\": {\"form\": \"position N_y(x) / D(x), pressure N_p(x) / D(x), x = s / w0\", \"w0\": "
+      << json_number(in.model->w0) << ", \"d\": " << numbers(in.model->d) << ", \"n_position\": " << numbers(in.model->n_position)
+      << ", \"n_pressure\": " << numbers(in.model->n_pressure) << ", \"rms_error_db\": " << json_number(in.model->rms_error_db) << "}";
   }
   if (in.relay) {
     const RelayResult& x = *in.relay;
