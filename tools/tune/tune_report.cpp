@@ -92,7 +92,7 @@ void write_tune_json(const TuneReportInput& in, const std::string& path) {
       << ", \"response\": " << numbers(r.step->response, 4) << "}";
   }
   if (in.model) {
-    o << ",\n  \"plant_model\": {\"form\": \"position N_y(x) / D(x), pressure N_p(x) / D(x), x = s / w0\", \"w0\": "
+    o << ",\n  \"plant_model\": {\"form\": \"position N_y(x) / (x^i D(x)), pressure N_p(x) / D(x), x = s / w0\", \"integrating\": " << (in.model->integrating ? "true" : "false") << ", \"w0\": "
       << json_number(in.model->w0) << ", \"d\": " << numbers(in.model->d) << ", \"n_position\": " << numbers(in.model->n_position)
       << ", \"n_pressure\": " << numbers(in.model->n_pressure) << ", \"rms_error_db\": " << json_number(in.model->rms_error_db) << "}";
   }
