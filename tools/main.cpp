@@ -174,6 +174,7 @@ int main(int argc, char** argv) {
   tune_cmd->add_option("--out", tune.out_path, "Write the config with the tuned gains (YAML, comments kept)");
   tune_cmd->add_option("--json", tune.json_path, "Write the design and its predictions (JSON)");
   tune_cmd->add_option("--plot", tune.plot_path, "Bode plot of the measured plant and the tuned loop (PNG)");
+  tune_cmd->add_option("--evaluate", tune.evaluate_path, "Only measure a run of the config's standard step (rigctl run --csv): overshoot, settling, IAE")->check(CLI::ExistingFile);
   tune_cmd->add_option("--relay-amplitude", tune.relay.amplitude, "Relay output about the hold command [command unit] (default: a tenth of the output limit)")->check(CLI::PositiveNumber);
   tune_cmd->add_option("--relay-hysteresis", tune.relay.hysteresis, "Relay hysteresis [feedback unit] (default: 3 x the sensor noise)")->check(CLI::PositiveNumber);
   tune_cmd->add_option("--relay-duration", tune.relay.duration_s, "Relay time [s]")->capture_default_str()->check(CLI::PositiveNumber);

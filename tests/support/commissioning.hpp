@@ -12,8 +12,6 @@
 #include "config/config_reader.hpp"
 #include "process.hpp"
 #include "tools/identify/frf_file.hpp"
-#include "tools/run/rig_assembly.hpp"
-#include "tools/runfile/run_file.hpp"
 #include "tools/tune/loop_design.hpp"
 #include "tools/tune/step_test.hpp"
 
@@ -35,14 +33,7 @@ inline StepMetrics run_step_test(const std::string& config, const std::string& d
   const std::string csv = dir + "/" + tag + "-step.csv";
   const auto r = rigctl("run " + config + " --fast --csv " + csv + " --log " + dir + "/" + tag + "-step.lcm");
   EXPECT_EQ(r.exit_code, 0) << r.output;
-  const RigConfig c = load_rig_config(config);
-  const std::string demand = setpoint_name_for(c.rig);
-  const RunFile f = read_run_file(csv, RunFileOptions{{c.controller.output, c.controller.feedback, demand}, {}, false, 10});
-  const auto& u = f.col(c.controller.output);
-  std::size_t first = 0;
-  while (first < u.size() && u[first] == 0.0) ++first;
-  const double offset = first > 0 ? f.t[first - 1] : 0.0;
-  return step_metrics(standard_step(c), f.t, f.col(demand), f.col(c.controller.feedback), offset);
+  return measured_step(load_rig_config(config), csv);
 }
 
 // The position loop of the config's gains on a measured plant.

@@ -11,6 +11,7 @@
 
 #include "commissioning.hpp"
 #include "config_edit.hpp"
+#include "tools/runfile/run_file.hpp"
 #include "read_file.hpp"
 
 namespace rigctl {

@@ -4,6 +4,9 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "tools/run/rig_assembly.hpp"
+#include "tools/runfile/run_file.hpp"
+
 namespace rigctl {
 
 namespace {
@@ -48,6 +51,16 @@ StepMetrics step_metrics(const StepTest& s, const std::vector<double>& t, const 
   }
   m.settling_s = last_outside - t0;
   return m;
+}
+
+StepMetrics measured_step(const RigConfig& c, const std::string& path) {
+  const std::string demand = setpoint_name_for(c.rig);
+  const RunFile f = read_run_file(path, RunFileOptions{{c.controller.output, c.controller.feedback, demand}, {}, false, 10});
+  const auto& u = f.col(c.controller.output);
+  std::size_t first = 0;
+  while (first < u.size() && u[first] == 0.0) ++first;
+  const double offset = first > 0 ? f.t[first - 1] : 0.0;
+  return step_metrics(standard_step(c), f.t, f.col(demand), f.col(c.controller.feedback), offset);
 }
 
 }  // namespace rigctl

@@ -6,6 +6,7 @@
 // measured run.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "config/rig_config.hpp"
@@ -32,5 +33,9 @@ struct StepMetrics {
 // t: profile (or run) time with the step at test.step_time_s + t_offset.
 StepMetrics step_metrics(const StepTest& test, const std::vector<double>& t, const std::vector<double>& demand,
                          const std::vector<double>& response, double t_offset = 0.0);
+
+// The standard step's metrics of a run of the config (a run file: `rigctl
+// run --csv`), the profile's time starting with the first driven tick.
+StepMetrics measured_step(const RigConfig& config, const std::string& run_file);
 
 }  // namespace rigctl

@@ -49,6 +49,13 @@ TuneResult run_tune(const TuneOptions& o, const std::atomic<bool>& stop, std::os
   const RigConfig config = load_rig_config(o.config_path, o.case_name);
   const LoopGains base = LoopGains::from_config(config);
   TuneResult result;
+  if (!o.evaluate_path.empty()) {
+    const StepMetrics m = measured_step(config, o.evaluate_path);
+    out << "rigctl tune --evaluate: " << o.evaluate_path << ": overshoot " << 100.0 * m.overshoot << " %, settling (2 %) "
+        << m.settling_s << " s, IAE " << m.iae << "\n";
+    result.gains = base;
+    return result;
+  }
   std::optional<FrfData> frf;
   std::optional<RelayResult> relay;
   std::optional<PlantModel> model;

@@ -52,6 +52,7 @@ struct TuneOptions {
   std::string out_path;   // tuned config (YAML)
   std::string json_path;  // design and predictions
   std::string plot_path;  // Bode plot of the tuned loop (PNG)
+  std::string evaluate_path;  // a run file of the config's standard step: its metrics, no design
   TuneMethod method = TuneMethod::kFrf;
   DesignTarget target;
   RelayOptions relay;
