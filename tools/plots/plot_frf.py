@@ -33,7 +33,7 @@ def db(z):
 
 def phase(z):
     p = np.degrees(np.unwrap(np.angle(z)))
-    return p - 360.0 if p[0] > 0 else p
+    return p - 360.0 if p[0] > 90.0 else p  # a loop lags at low frequency
 
 
 def plot_measurement(frf, out):

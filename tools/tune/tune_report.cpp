@@ -12,6 +12,10 @@ namespace rigctl {
 
 namespace {
 
+// A fit further off than this (rms over the coherent points) does not
+// predict a step: the plant is too nonlinear for one transfer function.
+constexpr double kTrustedFitDb = 3.0;
+
 std::string numbers(const std::vector<double>& v, std::size_t every = 1) {
   std::string s = "[";
   for (std::size_t i = 0; i < v.size(); i += every) s += (i ? ", " : "") + json_number(v[i]);
@@ -26,6 +30,10 @@ std::string margins_json(const Margins& m) {
 }
 
 void print_margins(const char* what, const Margins& m, std::ostream& out) {
+  if (!std::isfinite(m.crossover_hz)) {
+    out << "  " << what << ": no crossover in the measured band, sensitivity peak " << m.peak_sensitivity << "\n";
+    return;
+  }
   out << "  " << what << ": crossover " << m.crossover_hz << " Hz, phase margin " << m.phase_margin_deg << " deg, gain margin "
       << (m.gain_margin_beyond_band ? "at least " : "") << m.gain_margin_db << " dB"
       << (m.gain_margin_beyond_band ? " (no phase crossover in the band)" : " at " + std::to_string(m.phase_crossover_hz) + " Hz")
@@ -59,6 +67,10 @@ void print_tune(const TuneReportInput& in, std::ostream& out) {
   if (r.margins) print_margins("predicted (tuned gains on the measured plant)", *r.margins, out);
   if (r.step) {
     const auto& m = r.step->metrics;
+    if (in.model && in.model->rms_error_db > kTrustedFitDb) {
+      out << "  the fitted plant misses the measurement by " << in.model->rms_error_db
+          << " dB rms (a nonlinear plant): the predicted step below is rough\n";
+    }
     out << "  predicted standard step (" << r.step->test.step << " at " << r.step->test.step_time_s << " s): overshoot "
         << 100.0 * m.overshoot << " %, settling (2 %) " << m.settling_s << " s, IAE " << m.iae << "\n";
   }
