@@ -13,16 +13,31 @@ Complex z_inverse(double f_hz, double period_s) { return std::polar(1.0, -2.0 * 
 
 }  // namespace
 
+namespace {
+
+// A line's trust: its coherence, lowered by the distortion beside it where
+// the FRF has that (a nonlinear response is coherent but not linear).
+void lower_by_quality(std::vector<double>& quality, const FrfData& frf, const FrfCurve& c) {
+  const auto d = frf.distortion.find(c.response);
+  for (std::size_t i = 0; i < quality.size(); ++i) {
+    quality[i] = std::min(quality[i], c.coherence[i]);
+    if (d != frf.distortion.end()) quality[i] = std::min(quality[i], 1.0 - d->second[i]);
+  }
+}
+
+}  // namespace
+
 PlantResponse PlantResponse::from_frf(const FrfData& frf) {
   PlantResponse p;
   p.frequency_hz = frf.frequency_hz;
   const FrfCurve& pos = frf.plant_of(frf.responses.at(0).name);
   p.position = pos.value;
-  p.coherence = pos.coherence;
+  p.coherence.assign(p.frequency_hz.size(), 1.0);
+  lower_by_quality(p.coherence, frf, pos);
   if (frf.responses.size() > 1) {
     const FrfCurve& pr = frf.plant_of(frf.responses[1].name);
     p.pressure = pr.value;
-    for (std::size_t i = 0; i < p.coherence.size(); ++i) p.coherence[i] = std::min(p.coherence[i], pr.coherence[i]);
+    lower_by_quality(p.coherence, frf, pr);
   }
   return p;
 }

@@ -23,7 +23,7 @@ struct PlantResponse {
   std::vector<double> frequency_hz;
   std::vector<Complex> position;   // command -> controlled position (x_r, theta)
   std::vector<Complex> pressure;   // command -> differential pressure (P+V+dP only)
-  std::vector<double> coherence;   // the worst of the channels used
+  std::vector<double> coherence;   // the worst of the channels used, lowered by their distortion (1 - ratio)
 
   static PlantResponse from_frf(const FrfData& frf);
 };

@@ -29,17 +29,6 @@ std::string margins_json(const Margins& m) {
          ", \"peak_sensitivity\": " + json_number(m.peak_sensitivity) + "}";
 }
 
-void print_margins(const char* what, const Margins& m, std::ostream& out) {
-  if (!std::isfinite(m.crossover_hz)) {
-    out << "  " << what << ": no crossover in the measured band, sensitivity peak " << m.peak_sensitivity << "\n";
-    return;
-  }
-  out << "  " << what << ": crossover " << m.crossover_hz << " Hz, phase margin " << m.phase_margin_deg << " deg, gain margin "
-      << (m.gain_margin_beyond_band ? "at least " : "") << m.gain_margin_db << " dB"
-      << (m.gain_margin_beyond_band ? " (no phase crossover in the band)" : " at " + std::to_string(m.phase_crossover_hz) + " Hz")
-      << ", sensitivity peak " << m.peak_sensitivity << "\n";
-}
-
 // The tuned loop on the FRF's coherent frequencies (where the margins come from).
 std::string loop_json(const FrfData& frf, const LoopGains& g) {
   const PlantResponse p = PlantResponse::from_frf(frf);
@@ -55,6 +44,17 @@ std::string loop_json(const FrfData& frf, const LoopGains& g) {
 
 }  // namespace
 
+void print_margins(const char* what, const Margins& m, std::ostream& out) {
+  if (!std::isfinite(m.crossover_hz)) {
+    out << "  " << what << ": no crossover in the measured band, sensitivity peak " << m.peak_sensitivity << "\n";
+    return;
+  }
+  out << "  " << what << ": crossover " << m.crossover_hz << " Hz, phase margin " << m.phase_margin_deg << " deg, gain margin "
+      << (m.gain_margin_beyond_band ? "at least " : "") << m.gain_margin_db << " dB"
+      << (m.gain_margin_beyond_band ? " (no phase crossover in the band)" : " at " + std::to_string(m.phase_crossover_hz) + " Hz")
+      << ", sensitivity peak " << m.peak_sensitivity << "\n";
+}
+
 void print_tune(const TuneReportInput& in, std::ostream& out) {
   const TuneResult& r = *in.result;
   out << std::setprecision(4) << "rigctl tune: " << (in.options->method == TuneMethod::kRelay ? "relay (Ziegler-Nichols)" : "FRF loop shaping")
@@ -63,7 +63,6 @@ void print_tune(const TuneReportInput& in, std::ostream& out) {
   out << "\n  gains:";
   for (const auto& [k, v] : r.gains.config_values()) out << " " << k << " " << v;
   out << "\n";
-  if (r.present_margins) print_margins("measured loop (the gains of the identification)", *r.present_margins, out);
   if (r.margins) print_margins("predicted (tuned gains on the measured plant)", *r.margins, out);
   if (r.step) {
     const auto& m = r.step->metrics;

@@ -23,6 +23,7 @@ struct TuneReportInput {
 };
 
 void print_tune(const TuneReportInput& in, std::ostream& out);
+void print_margins(const char* what, const Margins& m, std::ostream& out);
 void write_tune_json(const TuneReportInput& in, const std::string& path);
 
 }  // namespace rigctl
