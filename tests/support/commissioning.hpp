@@ -43,18 +43,7 @@ inline Margins measured_margins(const std::string& frf_path, const std::string& 
 }
 
 // The same loop straight from the measured closed loop, L = T / (1 - T).
-inline Margins closed_loop_margins(const std::string& frf_path) {
-  const FrfData frf = read_frf_file(frf_path);
-  std::vector<double> f;
-  std::vector<Complex> t;
-  const FrfCurve& cl = frf.closed_loop.front();
-  for (std::size_t i = 0; i < frf.frequency_hz.size(); ++i) {
-    if (cl.coherence[i] < kDesignCoherence) continue;
-    f.push_back(frf.frequency_hz[i]);
-    t.push_back(cl.value[i]);
-  }
-  return loop_margins(f, loop_from_closed_loop(t));
-}
+inline Margins closed_loop_margins(const std::string& frf_path) { return rigctl::closed_loop_margins(read_frf_file(frf_path)); }
 
 inline double gain_of(const std::string& config, const std::string& key) {
   return LoopGains::from_config(load_rig_config(config)).config_values().at(key);

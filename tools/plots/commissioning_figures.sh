@@ -32,8 +32,8 @@ commission() {
     check=(--amplitude "$(/usr/bin/python3 -c "import json; print(0.0025 * $gain / json.load(open('$dir/tune.json'))['gains']['kp'])")")
   fi
   "$rigctl" identify "$dir/tuned.yaml" --fast --out "$dir/check.json" --log "$dir/check.lcm" "${check[@]}" >/dev/null
-  echo -n "tuned loop measured again: "
-  { "$rigctl" tune "$dir/tuned.yaml" --frf "$dir/check.json" --phase-margin "$pm" 2>&1 || true; } | grep "measured loop" | sed 's/^ *measured loop (the gains of the identification): //'
+  echo "tuned loop identified again:"
+  { "$rigctl" tune "$dir/tuned.yaml" --frf "$dir/check.json" --phase-margin "$pm" 2>&1 || true; } | grep "measured"
   for gains in start:"$dir/start.yaml" shipped:"$config" tuned:"$dir/tuned.yaml" relay-zn:"$dir/zn.yaml"; do
     "$rigctl" run "${gains#*:}" --fast --csv "$dir/${gains%%:*}.csv" --log "$dir/${gains%%:*}.lcm" >/dev/null
     echo -n "step test, ${gains%%:*} gains: "

@@ -5,6 +5,8 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "tools/tune/plant_grid.hpp"
+
 namespace rigctl {
 
 namespace {
@@ -92,6 +94,18 @@ std::vector<Complex> loop_transfer(const LoopGains& g, const PlantResponse& p) {
     out.push_back(loop_transfer_at(g, p.frequency_hz[i], p.position[i], p.pressure.empty() ? Complex{} : p.pressure[i]));
   }
   return out;
+}
+
+Margins closed_loop_margins(const FrfData& frf) {
+  std::vector<double> f;
+  std::vector<Complex> t;
+  const FrfCurve& cl = frf.closed_loop.front();
+  for (std::size_t i = 0; i < frf.frequency_hz.size(); ++i) {
+    if (cl.coherence[i] < kDesignCoherence) continue;
+    f.push_back(frf.frequency_hz[i]);
+    t.push_back(cl.value[i]);
+  }
+  return loop_margins(f, loop_from_closed_loop(t));
 }
 
 }  // namespace rigctl

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "tools/identify/frf_data.hpp"
+#include "tools/tune/margins.hpp"
 #include "tools/tune/loop_gains.hpp"
 
 namespace rigctl {
@@ -40,5 +41,8 @@ Complex loop_transfer_at(const LoopGains& g, double f_hz, Complex position, Comp
 Complex inner_loop_at(const LoopGains& g, double f_hz, Complex position, Complex pressure);
 // The position loop measured from a closed-loop FRF: T / (1 - T).
 std::vector<Complex> loop_from_closed_loop(const std::vector<Complex>& t);
+// Its margins on the closed loop's coherent lines (no plant estimate and no
+// controller model in between).
+Margins closed_loop_margins(const FrfData& frf);
 
 }  // namespace rigctl

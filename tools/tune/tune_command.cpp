@@ -75,6 +75,7 @@ TuneResult run_tune(const TuneOptions& o, const std::atomic<bool>& stop, std::os
     const PlantGrid grid(plant);
     result.present_margins = margins_of(grid, gains_of_frf(*frf, base));
     print_margins("measured loop (the gains of the identification)", *result.present_margins, out);
+    print_margins("measured closed loop as T / (1 - T)", closed_loop_margins(*frf), out);
     if (o.method == TuneMethod::kFrf) {
       DesignTarget target = o.target;
       if (config.profile.type == ProfileKind::kRampSteps && config.profile.filter_tau_s == 0.0) {
