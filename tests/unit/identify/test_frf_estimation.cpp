@@ -240,3 +240,34 @@ TEST(TunedConfig, ChangesOnlyTheGainValues) {
 
 }  // namespace
 }  // namespace rigctl
+
+namespace rigctl {
+namespace {
+
+std::string config_error(const std::string& yaml) {
+  try {
+    parse_rig_config(yaml, "bad.yaml");
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(IdentifyConfig, ReadsTheSectionAndNamesABadKey) {
+  const RigConfig c = parse_rig_config(test::shipped_config(), "q.yaml");
+  EXPECT_EQ(c.identify.excitation, ExcitationKind::kMultisine);
+  EXPECT_EQ(c.identify.resolution_hz, 0.5);
+  ASSERT_TRUE(c.identify.amplitude.has_value());
+  EXPECT_EQ(*c.identify.amplitude, 0.0025);
+  EXPECT_NE(config_error(test::edit(test::shipped_config(), "band_hz: \\[0.5, 30.0\\]", "band_hz: [30.0, 0.5]"))
+                .find("identify.band_hz: must be [low, high]"),
+            std::string::npos);
+  EXPECT_NE(config_error(test::edit(test::shipped_config(), "excitation: multisine", "excitation: sweep"))
+                .find("identify.excitation: unknown excitation 'sweep' (known: multisine, chirp, pink_noise)"),
+            std::string::npos);
+  EXPECT_NE(config_error(test::edit(test::shipped_config(), "  settle_s: 2.0", "  settle_s: 2.0\n  settle: 1.0")).find("identify.settle"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace rigctl
