@@ -51,7 +51,15 @@ void read_road(ConfigReader r, RoadProfileSpec& road) {
   road.iso.n_min = iso.number("n_min_cycles_per_m", 1e-4, 100.0);
   road.iso.n_max = iso.number("n_max_cycles_per_m", 1e-4, 100.0);
   if (!(road.iso.n_max > road.iso.n_min)) iso.fail("n_max_cycles_per_m", "must be above n_min_cycles_per_m");
-  road.iso.waves = static_cast<int>(iso.integer("waves", 1, 100000));
+  road.iso.length = iso.number("length_m", 100.0, 1e6);
+  if (road.iso.length * road.iso.n_min < 1.0) {
+    iso.fail("length_m", "must hold the longest wave: at least 1 / n_min_cycles_per_m = " +
+                              std::to_string(1.0 / road.iso.n_min) + " m");
+  }
+  // The road is generated on a grid of 8 points per shortest wave (plant/half_car/iso_road_table.hpp).
+  if (road.iso.length * 8.0 * road.iso.n_max > 16.0e6) {
+    iso.fail("length_m", "times 8 n_max_cycles_per_m would need over 16 million grid points; shorten it or lower n_max");
+  }
   road.iso.fade_in_distance = iso.number("fade_in_distance_m", 0.0, 1e5);
   iso.reject_unknown_keys();
 

@@ -5,7 +5,7 @@
 namespace rigctl {
 
 void read_quarter_car_plant(ConfigReader r, QuarterCarParams& p) {
-  p.substeps = static_cast<int>(r.integer("substeps", 1, 10000));
+  p.substeps = static_cast<int>(r.integer("substeps", 0, 10000));  // 0: from the fastest mode
   auto h = r.child("hydraulics");
   p.area_cap = h.number("area_cap_m2", 1e-6, 1.0);
   p.area_rod = h.number("area_rod_m2", 1e-6, 1.0);

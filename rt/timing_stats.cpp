@@ -26,10 +26,12 @@ TimingStats::TimingStats(int64_t period_ns, OverrunPolicy policy)
 
 void TimingStats::on_wake(int64_t deadline_ns, int64_t wake_ns) noexcept {
   latency_.record(wake_ns - deadline_ns);
+  stages_.begin(ticks_, wake_ns);
 }
 
 int64_t TimingStats::on_done(int64_t deadline_ns, int64_t start_ns, int64_t end_ns) noexcept {
   compute_.record(end_ns - start_ns);
+  stages_.finish();
   ++ticks_;
   const int64_t next = deadline_ns + period_ns_;
   if (end_ns <= next) return next;
@@ -49,6 +51,7 @@ TimingSummary TimingStats::summary() const noexcept {
   s.missed_ticks = missed_;
   s.wakeup_latency = latency_.summary();
   s.compute = compute_.summary();
+  s.stages = stages_.summary();
   return s;
 }
 

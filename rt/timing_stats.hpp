@@ -7,6 +7,7 @@
 #include <string_view>
 
 #include "rt/histogram.hpp"
+#include "rt/tick_stages.hpp"
 #include "rt/timing_summary.hpp"
 
 namespace rigctl {
@@ -32,8 +33,10 @@ class TimingStats {
   // with min/max kept exact.
   TimingStats(int64_t period_ns, OverrunPolicy policy);
 
-  // The loop woke for `deadline` at `wake`.
+  // The loop woke for `deadline` at `wake`: a tick begins.
   void on_wake(int64_t deadline_ns, int64_t wake_ns) noexcept;
+  // A step of the tick ended at `end` (it began where the previous one ended).
+  void on_stage(TickStage stage, int64_t end_ns) noexcept { stages_.end(stage, end_ns); }
   // The tick that started at `start` finished at `end`; returns the deadline
   // of the next tick according to the policy, counting overruns and misses.
   int64_t on_done(int64_t deadline_ns, int64_t start_ns, int64_t end_ns) noexcept;
@@ -48,6 +51,7 @@ class TimingStats {
   OverrunPolicy policy_;
   DurationHistogram latency_;
   DurationHistogram compute_;
+  TickStageTimes stages_;
   int64_t ticks_ = 0;
   int64_t overruns_ = 0;
   int64_t missed_ = 0;

@@ -3,6 +3,8 @@
 
 #include <cstdint>
 
+#include "rt/tick_stages.hpp"
+
 namespace rigctl {
 
 struct DistributionSummary {
@@ -21,7 +23,8 @@ struct TimingSummary {
   int64_t overruns = 0;      // ticks whose work ended after the next deadline
   int64_t missed_ticks = 0;  // periods skipped under the skip policy
   DistributionSummary wakeup_latency;  // wake-up time minus deadline
-  DistributionSummary compute;         // read-to-write time of one tick
+  DistributionSummary compute;         // wake-up to hand-off done, one tick
+  TickStageSummary stages;             // where the compute time went, per step of the tick
 };
 
 }  // namespace rigctl

@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <numbers>
-#include <random>
 #include <stdexcept>
 
 namespace rigctl {
@@ -11,10 +10,6 @@ namespace {
 
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 constexpr double kN0 = 0.1;  // ISO 8608 reference spatial frequency [cycle/m]
-
-// Uniform in [0, 1) from the raw 64-bit output: identical on every standard
-// library (std::uniform_real_distribution is not).
-double uniform01(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
 
 }  // namespace
 
@@ -57,27 +52,17 @@ RoadProfile::RoadProfile(const RoadProfileSpec& spec, double speed, WheelArrange
     if (!(iso.n_min > 0.0) || !(iso.n_max > iso.n_min)) {
       throw std::invalid_argument("road: ISO band needs 0 < n_min < n_max");
     }
-    if (iso.waves < 1) throw std::invalid_argument("road: ISO road needs at least one wave");
     if (iso.gd_n0 < 0.0) throw std::invalid_argument("road: Gd(n0) must not be negative");
     if (iso.fade_in_distance < 0.0) throw std::invalid_argument("road: fade-in distance must not be negative");
     gd_n0_ = iso.gd_n0 > 0.0 ? iso.gd_n0 : iso8608_gd_n0(iso.road_class);
-    std::mt19937_64 rng(iso.seed);
-    const auto n = static_cast<std::size_t>(iso.waves);
-    frequency_.resize(n);
-    amplitude_.resize(n);
-    const double ratio = iso.n_max / iso.n_min;
-    for (std::size_t k = 0; k < n; ++k) {
-      const double lo = iso.n_min * std::pow(ratio, static_cast<double>(k) / n);
-      const double hi = iso.n_min * std::pow(ratio, static_cast<double>(k + 1) / n);
-      // Integral of Gd(n0) (n/n0)^-2 over [lo, hi].
-      const double variance = gd_n0_ * kN0 * kN0 * (1.0 / lo - 1.0 / hi);
-      amplitude_[k] = std::sqrt(2.0 * variance);
-      frequency_[k] = lo * std::pow(hi / lo, uniform01(rng));
-    }
-    for (auto& track : phase_) {
-      track.resize(n);
-      for (auto& p : track) p = kTwoPi * uniform01(rng);
-    }
+    IsoRoadTableSpec table;
+    table.gd_n0 = gd_n0_;
+    table.n_min = iso.n_min;
+    table.n_max = iso.n_max;
+    table.seed = iso.seed;
+    table.tracks = 2;
+    table.min_length = iso.length;
+    iso_table_ = std::make_shared<const IsoRoadTable>(table);
   }
 }
 
@@ -113,24 +98,14 @@ RoadSample RoadProfile::train(double t_wheel) const noexcept {
 }
 
 double RoadProfile::track_height(int track, double x) const noexcept {
-  if (spec_.kind != RoadKind::kIso8608) return 0.0;
-  const auto& phase = phase_[static_cast<std::size_t>(track)];
-  double z = 0.0;
-  for (std::size_t k = 0; k < frequency_.size(); ++k) z += amplitude_[k] * std::cos(kTwoPi * frequency_[k] * x + phase[k]);
-  return z;
+  return iso_table_ ? iso_table_->at(track, x).z : 0.0;
 }
 
 // Height and slope dz/dx of a track with the fade-in applied.
 RoadSample RoadProfile::iso(int track, double x) const noexcept {
   if (x <= 0.0) return {};
-  const auto& phase = phase_[static_cast<std::size_t>(track)];
-  double z = 0.0, slope = 0.0;
-  for (std::size_t k = 0; k < frequency_.size(); ++k) {
-    const double w = kTwoPi * frequency_[k];
-    const double arg = w * x + phase[k];
-    z += amplitude_[k] * std::cos(arg);
-    slope -= amplitude_[k] * w * std::sin(arg);
-  }
+  const IsoRoadTable::Point p = iso_table_->at(track, x);
+  double z = p.z, slope = p.slope;
   const double fade = spec_.iso.fade_in_distance;
   if (fade > 0.0 && x < fade) {
     const double g = 0.5 * (1.0 - std::cos(std::numbers::pi * x / fade));

@@ -15,13 +15,10 @@
 //
 // ISO 8608 random road: displacement PSD Gd(n) = Gd(n0) (n/n0)^-2 with
 // n0 = 0.1 cycle/m, over the standard's band 0.011 <= n <= 2.83 cycle/m,
-// realised as a sum of `waves` cosines. The band is cut into log-spaced
-// sub-bands; each gets one cosine whose amplitude carries the exact variance
-// of its sub-band, sqrt(2 Gd(n0) n0^2 (1/n_lo - 1/n_hi)), at a log-uniform
-// random spatial frequency inside the sub-band and a uniform random phase,
-// drawn from a 64-bit Mersenne twister seeded by `seed` (same seed, same
-// road, on every platform: the draws use only the raw 64-bit outputs).
-// Gd(n0) is the class's geometric mean of ISO 8608:1995 Table 1
+// generated once per track by an inverse FFT on a uniform grid and read by
+// cubic Hermite interpolation (iso_road_table.hpp says why and how); the
+// track repeats after `length` (at least 5 km by default). Gd(n0) is the
+// class's geometric mean of ISO 8608:1995 Table 1
 // (1e-6 m^3): A 16, B 64, C 256, D 1024, E 4096 (class limits 32, 128, 512,
 // 2048, 8192). The road fades in over `fade_in_distance` (half-cosine
 // window) so that a run starting at rest sees no step.
@@ -36,7 +33,9 @@
 
 #include <array>
 #include <cstdint>
-#include <vector>
+#include <memory>
+
+#include "plant/half_car/iso_road_table.hpp"
 
 namespace rigctl {
 
@@ -81,7 +80,7 @@ struct IsoRoadSpec {
   uint64_t seed = 1;
   double n_min = 0.011;     // [cycle/m] ISO 8608 band
   double n_max = 2.83;      // [cycle/m]
-  int waves = 200;          // cosines per track
+  double length = 5000.0;   // [m] at least this before the track repeats
   double fade_in_distance = 10.0;  // [m]
 };
 
@@ -106,7 +105,8 @@ struct RoadSample {
 class RoadProfile {
  public:
   // speed: vehicle speed V [m/s] > 0. wheelbase: a + b [m] (in line only).
-  // Allocates the ISO waves here; at() never allocates.
+  // Generates the ISO road here (a few ms); at() never allocates. Copies
+  // share the generated road.
   RoadProfile(const RoadProfileSpec& spec, double speed, WheelArrangement arrangement, double wheelbase);
 
   // Road height and rate under wheel (0 = wheel 1, 1 = wheel 2) at time t.
@@ -120,12 +120,11 @@ class RoadProfile {
   // ISO road height of a track (0 or 1) at distance x [m], without the
   // fade-in; for tests of the class statistics.
   double track_height(int track, double x) const noexcept;
-  // Variance the ISO realisation carries by construction,
-  // Gd(n0) n0^2 (1/n_min - 1/n_max) [m^2]; 0 for the other kinds.
+  // Variance of the ISO class over the band, Gd(n0) n0^2 (1/n_min - 1/n_max)
+  // [m^2]; 0 for the other kinds.
   double iso_variance() const noexcept;
-  // Wave table of a track: spatial frequencies [cycle/m] and amplitudes [m].
-  const std::vector<double>& iso_frequencies() const noexcept { return frequency_; }
-  const std::vector<double>& iso_amplitudes() const noexcept { return amplitude_; }
+  // The generated ISO road (null for the other kinds).
+  const IsoRoadTable* iso_table() const noexcept { return iso_table_.get(); }
 
   const RoadProfileSpec& spec() const noexcept { return spec_; }
   double speed() const noexcept { return speed_; }
@@ -140,9 +139,7 @@ class RoadProfile {
   WheelArrangement arrangement_;
   double wheelbase_;
   double gd_n0_ = 0.0;
-  std::vector<double> frequency_;       // [cycle/m]
-  std::vector<double> amplitude_;       // [m]
-  std::array<std::vector<double>, 2> phase_;  // [rad] per track
+  std::shared_ptr<const IsoRoadTable> iso_table_;
 };
 
 }  // namespace rigctl

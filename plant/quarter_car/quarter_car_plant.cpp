@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "plant/quarter_car/quarter_car_step_size.hpp"
 #include "plant/servo_valve.hpp"
 
 namespace rigctl {
@@ -34,6 +35,7 @@ double expm1_minus_x(double x) {
 
 QuarterCarPlant::QuarterCarPlant(const QuarterCarParams& params)
     : params_(params),
+      fastest_rate_(quarter_car_fastest_rate(params)),
       signals_{{"x_r", "m"},       {"x_w", "m"},          {"x_b", "m"},
                {"v_w", "m/s"},     {"v_b", "m/s"},        {"p1", "Pa"},
                {"p2", "Pa"},       {"f_t", "N"},          {"sim_v_r", "m/s"},
@@ -274,7 +276,7 @@ void QuarterCarPlant::advance(std::span<const double> command, double dt) {
   if (!(dt > 0.0)) return;
   // A non-finite command must not poison the state; the driver flags it.
   const double u = held_command(command.empty() ? 0.0 : command[0]);
-  const int n = std::max(1, params_.substeps);
+  const int n = quarter_car_substeps(params_, fastest_rate_, dt);
   const double h = dt / n;
   for (int i = 0; i < n; ++i) substep(u, h);
 }

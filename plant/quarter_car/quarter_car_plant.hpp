@@ -176,6 +176,7 @@ class QuarterCarPlant : public SimulatedPlant {
   double end_stop_force(double x_r, double v_r) const;
 
   QuarterCarParams params_;
+  double fastest_rate_;  // [rad/s] bound for the sub-step count (quarter_car_step_size.hpp)
   std::vector<ChannelInfo> signals_;
   std::vector<ChannelInfo> commands_;
   Vec y_{};

@@ -79,6 +79,17 @@ int emit(lcm::LCM& lcm, lcm::LogFile* log, const std::string& channel, int64_t u
   return 0;
 }
 
+// The tick's steps as arrays in the timing message (publisher thread: it may allocate).
+void fill_stages(const TickStageSummary& st, rigctl::timing_t& m) {
+  m.stage_count = static_cast<int8_t>(kTickStageCount);
+  m.stage_name.clear();
+  m.stage_max_ns.assign(st.max_ns.begin(), st.max_ns.end());
+  m.stage_mean_ns.assign(st.mean_ns.begin(), st.mean_ns.end());
+  m.slowest_tick_stage_ns.assign(st.slowest_tick_ns.begin(), st.slowest_tick_ns.end());
+  for (std::size_t i = 0; i < kTickStageCount; ++i) m.stage_name.emplace_back(to_string(static_cast<TickStage>(i)));
+  m.slowest_tick = st.slowest_tick;
+}
+
 }  // namespace
 
 TelemetryPublisher::TelemetryPublisher(TelemetryMeta meta, const std::string& lcm_url,
@@ -332,6 +343,7 @@ void TelemetryPublisher::publish_record(const TelemetryRecord& r) {
     m.compute_p50_ns = tm.compute.p50_ns;
     m.compute_p99_ns = tm.compute.p99_ns;
     m.compute_p999_ns = tm.compute.p999_ns;
+    fill_stages(tm.stages, m);
     note_log_result(emit(*lcm_, log, channels_.timing, utime, m));
   }
 

@@ -39,11 +39,15 @@ LoopResult RigLoop::run(const std::atomic<bool>& stop_requested) {
       wait(run);
       if (notice_stop_request(stop_requested, run) == Step::kEndRun) break;
       if (read(run) == Step::kEndRun) break;
+      stamp(TickStage::kRead);
       if (check(run) == Step::kEndRun) break;
+      stamp(TickStage::kCheck);
       take_commands(run);
+      stamp(TickStage::kCommands);
       demand(run);
-      control_and_write(run);
-      hand_off(run);
+      stamp(TickStage::kDemand);
+      control_and_write(run);  // stamps kControl and kWrite
+      hand_off(run);           // stamps kHandOff
       if (decide_end(run) == Step::kEndRun) {
         ++run.tick;  // this tick was handed off: it counts
         break;
@@ -250,7 +254,9 @@ void RigLoop::control_and_write(RunState& run) {
   TelemetryRecord& r = run.record;
   if (run.valve_enabled) {
     controller_.update(run.demand, r.sample, r.command, r.controller);
+    stamp(TickStage::kControl);
     driver_.write(r.command);
+    stamp(TickStage::kWrite);
     if (machine_.state() == SafetyState::kRunning) run.ever_ran = true;
   } else {
     // The driver holds its safe command (Driver::make_safe, the one place
@@ -268,9 +274,13 @@ void RigLoop::hand_off(RunState& run) noexcept {
   r.safety_state = machine_.state();
   r.valve_enabled = run.valve_enabled;
   r.event = record_event(run);
-  run.deadline_ns = timing_.on_done(run.deadline_ns, run.woke_ns, clock_.now_ns());
   const bool timing_due = options_.timing_every_ticks > 0 && (run.tick + 1) % options_.timing_every_ticks == 0;
-  emit(r, timing_due);
+  emit(r, timing_due);  // its timing figures are those of the ticks before this one
+  // The tick's compute ends when the publisher has the record: a hand-off
+  // that waits is part of the tick, and of its overrun.
+  const int64_t done_ns = clock_.now_ns();
+  timing_.on_stage(TickStage::kHandOff, done_ns);
+  run.deadline_ns = timing_.on_done(run.deadline_ns, run.woke_ns, done_ns);
   // What the next tick's sample is judged against.
   run.previous_t_ns = run.t_ns();
   run.previous_demand = run.demand;

@@ -104,6 +104,8 @@ class RigLoop {
   void demand(RunState& run) noexcept;
   void control_and_write(RunState& run);
   void hand_off(RunState& run) noexcept;
+  // The step just done ends now (TimingStats::on_stage).
+  void stamp(TickStage stage) noexcept { timing_.on_stage(stage, clock_.now_ns()); }
   Step decide_end(RunState& run) noexcept;
   LoopResult finish_run(RunState& run) noexcept;
 

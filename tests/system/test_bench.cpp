@@ -109,21 +109,30 @@ TEST(BenchCommand, QuickRunWritesEverySection) {
   for (const auto& [name, value] : sections.members()) names.push_back(name);
   EXPECT_EQ(names, rigctl::bench_section_names());
 
-  // Timing: the loop always runs; cyclictest may be missing (skipped, with the reason).
+  // Timing: the loop always runs; cyclictest may be missing (skipped, with
+  // the reason). --quick makes one repetition per condition, each with the
+  // steps of its slowest tick.
   const Json& timing = member(sections, "timing");
   expect_ran(timing, "timing");
   for (const char* condition : {"idle", "load"}) {
     const Json& c = member(timing, condition);
-    const Json& loop = member(c, "rigctl");
-    expect_latency(member(loop, "wakeup_latency"), std::string(condition) + " loop wake-up");
-    expect_latency(member(loop, "compute"), std::string(condition) + " loop compute");
-    EXPECT_TRUE(member(loop, "compute_fraction_of_period").contains("p99"));
-    const Json& ct = member(c, "cyclictest");
-    expect_ran(ct, std::string(condition) + " cyclictest");
-    if (member(ct, "status").string() == "ok") {
-      expect_latency(member(ct, "wakeup_latency"), std::string(condition) + " cyclictest");
-      EXPECT_TRUE(c.contains("ratio_rigctl_over_cyclictest"));
+    const Json& runs = member(c, "runs");
+    ASSERT_EQ(runs.size(), 1u) << condition;
+    for (const Json& run : runs.items()) {
+      const Json& loop = member(run, "rigctl");
+      expect_latency(member(loop, "wakeup_latency"), std::string(condition) + " loop wake-up");
+      expect_latency(member(loop, "compute"), std::string(condition) + " loop compute");
+      EXPECT_TRUE(member(loop, "compute_fraction_of_period").contains("p99"));
+      EXPECT_TRUE(member(member(loop, "stages"), "max_us").contains("hand_off"));
+      const Json& ct = member(run, "cyclictest");
+      expect_ran(ct, std::string(condition) + " cyclictest");
+      if (member(ct, "status").string() == "ok") {
+        expect_latency(member(ct, "wakeup_latency"), std::string(condition) + " cyclictest");
+        EXPECT_TRUE(member(member(c, "ratio_rigctl_over_cyclictest"), "p99").contains("median"));
+      }
     }
+    EXPECT_TRUE(member(c, "compute_max_us").contains("median"));
+    EXPECT_GE(member(member(c, "slowest_tick_of_all_runs"), "slowest_tick").number(), 0);
   }
 
   // Plant: every case, its reference, the fixed-step sweep with errors, and

@@ -11,6 +11,7 @@
 #include <span>
 
 #include "config/rig_config.hpp"
+#include "plant/quarter_car/quarter_car_step_size.hpp"
 #include "rt/loop_clock.hpp"
 #include "rt/loop/rig_loop.hpp"
 #include "tools/bench/sections.hpp"
@@ -227,7 +228,7 @@ Section plant_section() {
             const std::atomic<bool>& stop = ctx.stop;
             std::vector<Case> cases;
             cases.push_back({"quarter_car", "config/quarter_car.yaml plant (hydraulics, leakage, bearing stick-slip), commands of its PI closed loop on the 50 mm step test",
-                             "x_r", qc.quarter_car.substeps,
+                             "x_r", quarter_car_substeps(qc.quarter_car, T),
                              [&](int n, int reps) { return run_fixed<QuarterCarPlant>(qc.quarter_car, n, qc_u, T, reps); },
                              [&](double tol) { return reference_quarter_car(qc.quarter_car, qc_u, T, tol, stop); },
                              [&](const FixedRun& f, int& checked) {

@@ -13,6 +13,7 @@
 #include <span>
 
 #include "config/rig_config.hpp"
+#include "plant/quarter_car/quarter_car_step_size.hpp"
 #include "tools/bench/sections.hpp"
 #include "tools/run/rig_assembly.hpp"
 
@@ -104,7 +105,7 @@ Section scaling_section() {
               const CommandSeries* u;
             };
             const std::vector<PlantCase> plants = {
-                {"quarter_car", qc.quarter_car.substeps,
+                {"quarter_car", quarter_car_substeps(qc.quarter_car, qc.loop.period_s),
                  [&](int n) {
                    QuarterCarParams p = qc.quarter_car;
                    p.substeps = n;

@@ -2,10 +2,13 @@
 // car through `rigctl run`'s own code path, paced at the config's period and
 // SCHED_FIFO priority) against cyclictest (Debian rt-tests) at the same
 // interval and priority, one after the other; idle, then under a CPU load of
-// one busy thread per CPU. Also the compute time of one tick (read to write)
-// as a fraction of the period.
+// one busy thread per CPU. Each condition is measured three times,
+// interleaved (loop, cyclictest, loop, ...), and the ratios are reported as
+// median and spread: one run says little on a shared VM. Also the compute
+// time of one tick and the steps of the slowest tick.
 #include <sys/mman.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <exception>
@@ -17,6 +20,7 @@
 
 #include "config/rig_config.hpp"
 #include "tools/bench/sections.hpp"
+#include "tools/common/stage_text.hpp"
 #include "tools/run/run_command.hpp"
 
 namespace rigctl::bench {
@@ -149,6 +153,107 @@ std::vector<std::string> latency_cells(const DistributionSummary& d) {
           fmt("%.1f", d.max_ns / 1e3)};
 }
 
+
+std::vector<std::string> row_of(const std::string& condition, int run, const std::string& source,
+                                const DistributionSummary& d, const Json& run_json) {
+  std::vector<std::string> row = {condition, std::to_string(run), source};
+  for (auto& cell : latency_cells(d)) row.push_back(cell);
+  const Json* overruns = run_json.find("overruns");
+  row.push_back(overruns ? fmt("%.0f", overruns->number()) : "");
+  const Json* steal = run_json.find("cpu_steal_fraction");
+  row.push_back(steal ? fmt("%.1f", 100.0 * steal->number()) : "");
+  return row;
+}
+
+// Min, median and max of a few values (the repetitions of one figure).
+Json spread_json(std::vector<double> v) {
+  Json j = Json::object();
+  if (v.empty()) return j;
+  std::sort(v.begin(), v.end());
+  j["min"] = v.front();
+  j["median"] = v.size() % 2 == 1 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+  j["max"] = v.back();
+  return j;
+}
+
+std::string spread_cell(const Json& s) {
+  if (s.find("median") == nullptr) return "-";
+  return fmt("%.2f", s.find("median")->number()) + " (" + fmt("%.2f", s.find("min")->number()) + "-" +
+         fmt("%.2f", s.find("max")->number()) + ")";
+}
+
+Json stages_json(const TickStageSummary& st) {
+  Json max = Json::object(), slowest = Json::object();
+  for (std::size_t i = 0; i < kTickStageCount; ++i) {
+    const std::string name(to_string(static_cast<TickStage>(i)));
+    max[name] = static_cast<double>(st.max_ns[i]) / 1e3;
+    slowest[name] = static_cast<double>(st.slowest_tick_ns[i]) / 1e3;
+  }
+  Json j = Json::object();
+  j["max_us"] = max;
+  j["slowest_tick"] = st.slowest_tick;
+  j["slowest_tick_us"] = slowest;
+  return j;
+}
+
+// One repetition: the loop, then cyclictest, under the same condition.
+struct Repetition {
+  Json json = Json::object();
+  TimingSummary loop;
+  std::optional<DistributionSummary> kernel;
+};
+
+Repetition repetition(Context& ctx, const RealtimeConfig& rt, bool fifo, int64_t period_us, double seconds,
+                      const std::string& tag) {
+  Repetition r;
+  const CpuTimes loop_before = read_cpu_times();
+  r.loop = run_loop(ctx, seconds, tag).timing;
+  Json l = Json::object();
+  l["wakeup_latency"] = latency_json(r.loop.wakeup_latency);
+  l["compute"] = latency_json(r.loop.compute);
+  l["compute_fraction_of_period"] = fraction_json(r.loop.compute, period_us * 1000);
+  l["stages"] = stages_json(r.loop.stages);
+  l["ticks"] = r.loop.ticks;
+  l["overruns"] = r.loop.overruns;
+  l["missed_ticks"] = r.loop.missed_ticks;
+  l["cpu_steal_fraction"] = steal_fraction(loop_before, read_cpu_times());
+  l["load_average_1min_after"] = load_average_1min();
+  r.json["rigctl"] = l;
+  if (ctx.stop.load()) return r;
+  const CpuTimes ct_before = read_cpu_times();
+  const int64_t loops = std::llround(seconds * 1e6 / static_cast<double>(period_us));
+  CyclictestRun ct = run_cyclictest(ctx, rt, fifo, period_us, loops, tag);
+  ct.json["cpu_steal_fraction"] = steal_fraction(ct_before, read_cpu_times());
+  r.json["cyclictest"] = ct.json;
+  r.kernel = ct.latency;
+  if (!ct.latency) {
+    const Json* why = ct.json.find("reason");
+    if (why == nullptr) why = ct.json.find("error");
+    ctx.out << "  cyclictest (" << tag << "): " << (why ? why->string() : "no result") << "\n";
+  }
+  return r;
+}
+
+struct ConditionFigures {
+  std::vector<double> p50, p99, p999, max;  // ratios rigctl / cyclictest
+  std::vector<double> compute_max_us, overruns;
+  TimingSummary worst;  // the repetition with the longest tick
+};
+
+void add(ConditionFigures& f, const Repetition& r) {
+  const DistributionSummary& w = r.loop.wakeup_latency;
+  if (r.kernel) {
+    const DistributionSummary& k = *r.kernel;
+    f.p50.push_back(ratio(w.p50_ns, k.p50_ns));
+    f.p99.push_back(ratio(w.p99_ns, k.p99_ns));
+    f.p999.push_back(ratio(w.p999_ns, k.p999_ns));
+    f.max.push_back(ratio(w.max_ns, k.max_ns));
+  }
+  f.compute_max_us.push_back(static_cast<double>(r.loop.compute.max_ns) / 1e3);
+  f.overruns.push_back(static_cast<double>(r.loop.overruns));
+  if (f.compute_max_us.size() == 1 || r.loop.compute.max_ns > f.worst.compute.max_ns) f.worst = r.loop;
+}
+
 }  // namespace
 
 Section timing_section() {
@@ -158,7 +263,6 @@ Section timing_section() {
             const int64_t period_ns = std::llround(config.loop.period_s * 1e9);
             const int64_t period_us = period_ns / 1000;
             const double seconds = ctx.pick(30.0, 2.0);
-            const int64_t loops = std::llround(seconds / config.loop.period_s);
             const std::string refusal = rt.enabled ? realtime_refusal(rt.priority) : "real-time disabled in the config";
             const bool fifo = refusal.empty();
             const int load_threads = static_cast<int>(std::max<long>(1, sysconf(_SC_NPROCESSORS_ONLN)));
@@ -170,81 +274,57 @@ Section timing_section() {
             j["cpu"] = rt.cpu;
             j["scheduling"] = fifo ? "SCHED_FIFO " + std::to_string(rt.priority) : "best effort: " + refusal;
             j["seconds_per_run"] = seconds;
-            j["order"] = "per condition: rigctl loop, then cyclictest";
             ctx.out << "  " << seconds << " s each at " << period_us << " us, "
                     << (fifo ? "SCHED_FIFO " + std::to_string(rt.priority) : "best effort (" + refusal + ")")
                     << (rt.hold_cpu_dma_latency ? ", cpu_dma_latency held at 0 (as configured)" : "") << "\n";
 
-            Table latency({"condition", "source", "p50 us", "p99 us", "p99.9 us", "max us", "overruns", "steal %"});
-            Table compute({"condition", "compute p50 us", "p99 us", "max us", "p50/period", "p99/period", "max/period"});
+            const int repetitions = ctx.pick(3, 1);
+            j["repetitions"] = repetitions;
+            j["order"] = "per condition, interleaved: rigctl loop, cyclictest, rigctl loop, cyclictest, ...";
+            Table latency({"condition", "run", "source", "p50 us", "p99 us", "p99.9 us", "max us", "overruns", "steal %"});
+            Table ratios({"condition", "p50", "p99", "p99.9", "max", "tick compute max us", "overruns"});
             for (const std::string condition : {"idle", "load"}) {
               if (ctx.stop.load()) break;
               Json c = Json::object();
               std::optional<CpuLoad> load;
               if (condition == "load") {
-                load.emplace(load_threads, 4 * seconds + 60.0);
+                load.emplace(load_threads, repetitions * (4 * seconds + 30.0) + 30.0);
                 c["load"] = std::to_string(load_threads) +
                             " busy threads (normal priority) streaming through 8 MB buffers each";
               }
               c["load_average_1min_before"] = load_average_1min();
-
-              const CpuTimes loop_before = read_cpu_times();
-              const LoopRun loop = run_loop(ctx, seconds, condition);
-              const double loop_steal = steal_fraction(loop_before, read_cpu_times());
-              const TimingSummary& t = loop.timing;
-              Json l = Json::object();
-              l["wakeup_latency"] = latency_json(t.wakeup_latency);
-              l["compute"] = latency_json(t.compute);
-              l["compute_fraction_of_period"] = fraction_json(t.compute, period_ns);
-              l["ticks"] = t.ticks;
-              l["overruns"] = t.overruns;
-              l["missed_ticks"] = t.missed_ticks;
-              l["cpu_steal_fraction"] = loop_steal;
-              c["rigctl"] = l;
-              std::vector<std::string> row = {condition, "rigctl loop"};
-              for (auto& cell : latency_cells(t.wakeup_latency)) row.push_back(cell);
-              row.push_back(std::to_string(t.overruns));
-              row.push_back(fmt("%.1f", 100.0 * loop_steal));
-              latency.row(row);
-              compute.row({condition, fmt("%.1f", t.compute.p50_ns / 1e3), fmt("%.1f", t.compute.p99_ns / 1e3),
-                           fmt("%.1f", t.compute.max_ns / 1e3),
-                           fmt("%.2f%%", 100.0 * ratio(t.compute.p50_ns, period_ns)),
-                           fmt("%.2f%%", 100.0 * ratio(t.compute.p99_ns, period_ns)),
-                           fmt("%.2f%%", 100.0 * ratio(t.compute.max_ns, period_ns))});
-
-              if (!ctx.stop.load()) {
-                const CpuTimes ct_before = read_cpu_times();
-                const CyclictestRun ct = run_cyclictest(ctx, rt, fifo, period_us, loops, condition);
-                const double ct_steal = steal_fraction(ct_before, read_cpu_times());
-                c["cyclictest"] = ct.json;
-                c["cyclictest"]["cpu_steal_fraction"] = ct_steal;
-                if (ct.latency) {
-                  const DistributionSummary& k = *ct.latency;
-                  std::vector<std::string> krow = {condition, "cyclictest"};
-                  for (auto& cell : latency_cells(k)) krow.push_back(cell);
-                  krow.push_back("");
-                  krow.push_back(fmt("%.1f", 100.0 * ct_steal));
-                  latency.row(krow);
-                  Json r = Json::object();
-                  r["p50"] = ratio(t.wakeup_latency.p50_ns, k.p50_ns);
-                  r["p99"] = ratio(t.wakeup_latency.p99_ns, k.p99_ns);
-                  r["p999"] = ratio(t.wakeup_latency.p999_ns, k.p999_ns);
-                  r["max"] = ratio(t.wakeup_latency.max_ns, k.max_ns);
-                  c["ratio_rigctl_over_cyclictest"] = r;
-                  latency.row({condition, "ratio", fmt("%.2f", r["p50"].number()), fmt("%.2f", r["p99"].number()),
-                               fmt("%.2f", r["p999"].number()), fmt("%.2f", r["max"].number())});
-                } else {
-                  const Json* why = ct.json.find("reason");
-                  if (why == nullptr) why = ct.json.find("error");
-                  ctx.out << "  cyclictest (" << condition << "): " << (why ? why->string() : "no result") << "\n";
-                }
+              ConditionFigures f;
+              Json runs = Json::array();
+              for (int k = 0; k < repetitions && !ctx.stop.load(); ++k) {
+                const std::string tag = condition + "-" + std::to_string(k + 1);
+                Repetition r = repetition(ctx, rt, fifo, period_us, seconds, tag);
+                add(f, r);
+                runs.push_back(r.json);
+                latency.row(row_of(condition, k + 1, "rigctl loop", r.loop.wakeup_latency, r.json["rigctl"]));
+                if (r.kernel) latency.row(row_of(condition, k + 1, "cyclictest", *r.kernel, r.json["cyclictest"]));
               }
               if (load) load->stop();
+              c["runs"] = runs;
+              Json summary = Json::object();
+              summary["p50"] = spread_json(f.p50);
+              summary["p99"] = spread_json(f.p99);
+              summary["p999"] = spread_json(f.p999);
+              summary["max"] = spread_json(f.max);
+              c["ratio_rigctl_over_cyclictest"] = summary;
+              c["compute_max_us"] = spread_json(f.compute_max_us);
+              c["overruns"] = spread_json(f.overruns);
+              c["slowest_tick_of_all_runs"] = stages_json(f.worst.stages);
               c["load_average_1min_after"] = load_average_1min();
+              ratios.row({condition, spread_cell(summary["p50"]), spread_cell(summary["p99"]), spread_cell(summary["p999"]),
+                          spread_cell(summary["max"]), spread_cell(c["compute_max_us"]), spread_cell(c["overruns"])});
+              ctx.out << "  " << condition << ": slowest tick " << f.worst.stages.slowest_tick << " of its run: "
+                      << describe_stages(f.worst.stages.slowest_tick_ns) << "\n";
               j[condition] = c;
             }
-            ctx.out << "  wake-up latency (time past the deadline; steal: CPU time the hypervisor took during the run):\n" << latency.text("    ")
-                    << "  compute per tick (read to write; period " << period_us << " us):\n" << compute.text("    ");
+            ctx.out << "  wake-up latency (time past the deadline; steal: CPU time the hypervisor took during the run):\n"
+                    << latency.text("    ")
+                    << "  rigctl over cyclictest, median (min-max) of " << repetitions << ", and the tick's compute:\n"
+                    << ratios.text("    ");
             return j;
           }};
 }

@@ -1,3 +1,4 @@
+#include "tools/common/stage_text.hpp"
 #include "tools/run/run_command.hpp"
 
 #include <spdlog/spdlog.h>
@@ -232,6 +233,8 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
   if (!options.fast) {
     out << "  wake-up latency: " << describe(t.wakeup_latency) << "\n"
         << "  compute per tick: " << describe(t.compute) << "\n"
+        << "    longest per step: " << describe_stages(t.stages.max_ns) << "\n"
+        << "    slowest tick (" << t.stages.slowest_tick << "): " << describe_stages(t.stages.slowest_tick_ns) << "\n"
         << (rig.driver->io_latency().count > 0 ? "  I/O round trip: " + describe(rig.driver->io_latency()) + "\n" : "")
         << "  overruns: " << t.overruns << " (missed ticks " << t.missed_ticks << ", policy "
         << to_string(config.loop.overrun_policy) << ")\n";
