@@ -77,33 +77,64 @@ LoopGains ziegler_nichols(LoopGains g, double ku, double tu) {
   return g;
 }
 
+namespace {
+
+LeadIn lead_in_to(const RigConfig& c, double op) {
+  return LeadIn{c.profile.start, op, c.profile.hold_s, c.profile.ramp_rate > 0.0 ? c.profile.ramp_rate : c.safety.setpoint_rate};
+}
+
+RelaySettings relay_settings(const RigConfig& c, const RelayOptions& ro, double stabiliser_gain, double op) {
+  const LoopGains base = LoopGains::from_config(c);
+  RelaySettings s;
+  s.stabiliser_gain = stabiliser_gain > 0.0 ? stabiliser_gain : proportional_gain(c);
+  s.output_limit = base.output_limit;
+  s.amplitude = ro.amplitude > 0.0 ? ro.amplitude : 0.1 * base.output_limit;  // a tenth of the valve's range
+  s.hysteresis = ro.hysteresis > 0.0 ? ro.hysteresis : default_hysteresis(c);
+  s.amplitude_clamp = amplitude_clamp(c, op, c.identify.band_min_hz).limit;
+  s.hold_ticks = std::llround((lead_in_to(c, op).duration() + kSettleS) / c.loop.period_s);
+  s.learn_ticks = std::llround(1.0 / c.loop.period_s);
+  return s;
+}
+
+// The limit cycle in the run file: the relay starts hold_ticks after the
+// first driven tick; its first third is left out.
+Cycle cycle_in_run(const std::string& csv, const RigConfig& c, const RelaySettings& s, double duration_s) {
+  const RunFile f = read_run_file(csv, RunFileOptions{{c.controller.output, c.controller.feedback}, {}, false, 10});
+  const auto& u = f.col(c.controller.output);
+  std::size_t first_driven = 0;
+  while (first_driven < u.size() && u[first_driven] == 0.0) ++first_driven;
+  const auto relay_start = first_driven + static_cast<std::size_t>(s.hold_ticks);
+  const auto relay_ticks = static_cast<std::size_t>(duration_s / c.loop.period_s);
+  const std::size_t from = relay_start + static_cast<std::size_t>(kDiscardShare * static_cast<double>(relay_ticks));
+  const std::size_t to = std::min(u.size(), relay_start + relay_ticks);
+  const Cycle cycle = from < to ? analyse_cycle(f.t, u, f.col(c.controller.feedback), from, to) : Cycle{};
+  if (cycle.cycles < 2 || !(cycle.amplitude > s.hysteresis)) {
+    throw std::runtime_error("the relay found no limit cycle (" + std::to_string(cycle.cycles) + " cycles, amplitude " +
+                             std::to_string(cycle.amplitude) + "): lengthen --relay-duration or raise --relay-amplitude");
+  }
+  return cycle;
+}
+
+}  // namespace
+
 RelayResult run_relay_experiment(const RigConfig& config, const TuneOptions& o, double stabiliser_gain,
                                  const std::atomic<bool>& stop, std::ostream& out) {
   const RelayOptions& ro = o.relay;
-  const LoopGains base = LoopGains::from_config(config);
   const double op = default_operating_point(config);
-  RelaySettings s;
-  s.stabiliser_gain = stabiliser_gain > 0.0 ? stabiliser_gain : proportional_gain(config);
-  s.output_limit = base.output_limit;
-  s.amplitude = ro.amplitude > 0.0 ? ro.amplitude : 0.1 * base.output_limit;  // a tenth of the valve's range
-  s.hysteresis = ro.hysteresis > 0.0 ? ro.hysteresis : default_hysteresis(config);
-  s.amplitude_clamp = amplitude_clamp(config, op, config.identify.band_min_hz).limit;
-  const double period = config.loop.period_s;
-  LeadIn lead{config.profile.start, op, config.profile.hold_s,
-              config.profile.ramp_rate > 0.0 ? config.profile.ramp_rate : config.safety.setpoint_rate};
-  s.hold_ticks = std::llround((lead.duration() + kSettleS) / period);
-  s.learn_ticks = std::llround(1.0 / period);
+  const RelaySettings s = relay_settings(config, ro, stabiliser_gain, op);
   out << "rigctl tune --method relay: relay +-" << s.amplitude << " about the hold command, hysteresis " << s.hysteresis
       << ", amplitude clamp " << s.amplitude_clamp << ", " << ro.duration_s << " s about " << config.controller.feedback
       << " = " << op << "\n";
-
   RunOptions run;
   run.config_path = o.config_path;
   run.fast = ro.fast;
   run.realtime = ro.realtime;
   run.log_path = ro.log_path;
   run.csv_path = (ro.log_path.empty() ? std::filesystem::temp_directory_path().string() + "/rigctl-relay" : ro.log_path) + ".csv";
-  run.profile_override = [&] { return std::make_unique<ExcitationProfile>(lead, kSettleS, std::vector<double>{}, period, ro.duration_s); };
+  run.profile_override = [&] {
+    return std::make_unique<ExcitationProfile>(lead_in_to(config, op), kSettleS, std::vector<double>{}, config.loop.period_s,
+                                               ro.duration_s);
+  };
   run.controller_override = [&](const ChannelLayout& layout) {
     RelaySettings placed = s;
     placed.feedback_input = layout.input_index(config.controller.feedback);
@@ -119,26 +150,14 @@ RelayResult run_relay_experiment(const RigConfig& config, const TuneOptions& o, 
     r.abort_reason = stop.load() ? "stop requested" : report.end_reason;
     return r;
   }
-  const RunFile f = read_run_file(run.csv_path, RunFileOptions{{config.controller.output, config.controller.feedback}, {}, false, 10});
-  const auto& u = f.col(config.controller.output);
-  std::size_t first_driven = 0;
-  while (first_driven < u.size() && u[first_driven] == 0.0) ++first_driven;
-  const auto relay_start = first_driven + static_cast<std::size_t>(s.hold_ticks);
-  const auto relay_ticks = static_cast<std::size_t>(ro.duration_s / period);
-  const std::size_t from = relay_start + static_cast<std::size_t>(kDiscardShare * static_cast<double>(relay_ticks));
-  const std::size_t to = std::min(u.size(), relay_start + relay_ticks);
-  const Cycle c = from < to ? analyse_cycle(f.t, u, f.col(config.controller.feedback), from, to) : Cycle{};
-  if (c.cycles < 2 || !(c.amplitude > s.hysteresis)) {
-    throw std::runtime_error("the relay found no limit cycle (" + std::to_string(c.cycles) + " cycles, amplitude " +
-                             std::to_string(c.amplitude) + "): lengthen --relay-duration or raise --relay-amplitude");
-  }
+  const Cycle c = cycle_in_run(run.csv_path, config, s, ro.duration_s);
   r.ultimate_period_s = c.period;
   r.oscillation_amplitude = c.amplitude;
   r.relay_amplitude = c.relay;
   r.hold_command = c.hold;
   r.cycles = c.cycles;
   r.ultimate_gain = 4.0 * c.relay / (std::numbers::pi * std::sqrt(c.amplitude * c.amplitude - s.hysteresis * s.hysteresis));
-  r.gains = ziegler_nichols(base, r.ultimate_gain, r.ultimate_period_s);
+  r.gains = ziegler_nichols(LoopGains::from_config(config), r.ultimate_gain, r.ultimate_period_s);
   out << "  limit cycle: Tu " << r.ultimate_period_s << " s, amplitude " << r.oscillation_amplitude << " for relay +-"
       << r.relay_amplitude << " (" << r.cycles << " cycles): Ku " << r.ultimate_gain << "\n";
   return r;

@@ -43,6 +43,33 @@ void check_same_rig(const RigConfig& c, const FrfData& frf, const std::string& p
   }
 }
 
+// The FRF's part: the present loop's margins, the design (FRF method), the
+// margins of the gains on the measured plant, the fitted model and the
+// predicted step. Returns the fitted model.
+PlantModel design_on_frf(const FrfData& frf, const RigConfig& config, const LoopGains& base, const TuneOptions& o,
+                         TuneResult& result, std::ostream& out) {
+  const PlantResponse plant = PlantResponse::from_frf(frf);
+  const PlantGrid grid(plant);
+  result.present_margins = margins_of(grid, gains_of_frf(frf, base));
+  print_margins("measured loop (the gains of the identification)", *result.present_margins, out);
+  print_margins("measured closed loop as T / (1 - T)", closed_loop_margins(frf), out);
+  if (o.method == TuneMethod::kFrf) {
+    DesignTarget target = o.target;
+    if (config.profile.type == ProfileKind::kRampSteps && config.profile.filter_tau_s == 0.0) {
+      target.max_demand_gain = base.output_limit / std::abs(standard_step(config).step);
+    }
+    const LoopDesign d = design_loop(grid, base, target);
+    result.gains = d.gains;
+    result.note = d.note;
+  }
+  result.margins = margins_of(grid, result.gains);
+  PlantModel model = fit_plant(plant, config.loop.period_s);
+  if (config.profile.type == ProfileKind::kRampSteps) {
+    result.step = predict_step(model, result.gains, config, frf.operating_point.command_mean);
+  }
+  return model;
+}
+
 }  // namespace
 
 TuneResult run_tune(const TuneOptions& o, const std::atomic<bool>& stop, std::ostream& out) {
@@ -70,27 +97,7 @@ TuneResult run_tune(const TuneOptions& o, const std::atomic<bool>& stop, std::os
   } else if (!frf) {
     throw std::runtime_error("--frf FRF.json is needed (rigctl identify writes it), or --method relay");
   }
-  if (frf) {
-    const PlantResponse plant = PlantResponse::from_frf(*frf);
-    const PlantGrid grid(plant);
-    result.present_margins = margins_of(grid, gains_of_frf(*frf, base));
-    print_margins("measured loop (the gains of the identification)", *result.present_margins, out);
-    print_margins("measured closed loop as T / (1 - T)", closed_loop_margins(*frf), out);
-    if (o.method == TuneMethod::kFrf) {
-      DesignTarget target = o.target;
-      if (config.profile.type == ProfileKind::kRampSteps && config.profile.filter_tau_s == 0.0) {
-        target.max_demand_gain = base.output_limit / std::abs(standard_step(config).step);
-      }
-      const LoopDesign d = design_loop(grid, base, target);
-      result.gains = d.gains;
-      result.note = d.note;
-    }
-    result.margins = margins_of(grid, result.gains);
-    model = fit_plant(plant, config.loop.period_s);
-    if (config.profile.type == ProfileKind::kRampSteps) {
-      result.step = predict_step(*model, result.gains, config, frf->operating_point.command_mean);
-    }
-  }
+  if (frf) model = design_on_frf(*frf, config, base, o, result, out);
   const TuneReportInput report{std::string(to_string(config.rig)), &o, &result, frf ? &*frf : nullptr,
                                relay ? &*relay : nullptr, model ? &*model : nullptr};
   print_tune(report, out);
