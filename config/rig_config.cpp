@@ -209,6 +209,7 @@ RigConfig parse(ConfigReader root, const std::string& case_name) {
   if (root.has("limits")) c.limits = read_limits(root.child("limits"));
   if (root.has("safety")) c.safety = read_safety(root.child("safety"));
   if (root.has("operator")) c.operator_commands = read_operator(root.child("operator"), c.file);
+  if (root.has("identify")) c.identify = read_identify(root.child("identify"));
   if (root.has("faults")) {
     for (const auto& text : root.texts("faults", [](const std::string& t) { parse_fault_spec(t); })) {
       c.faults.push_back(parse_fault_spec(text));

@@ -12,6 +12,7 @@
 #include "config/controller_kind.hpp"
 #include "config/detector_kinds.hpp"
 #include "config/driver_kind.hpp"
+#include "config/identify_config.hpp"
 #include "config/operator_config.hpp"
 #include "config/profile_kind.hpp"
 #include "config/rig_kind.hpp"
@@ -133,6 +134,7 @@ struct RigConfig {
   SafetyConfig safety;  // `safety:`; optional, defaults as SafetyConfig{}
   OperatorConfig operator_commands;  // `operator:`; optional (config/operator_config.hpp)
   std::vector<FaultSpec> faults;     // `faults:`; optional list of KIND@TIME[:ARG...] (drivers/sim/sim_faults.hpp)
+  IdentifyConfig identify;           // `identify:`; optional (config/identify_config.hpp)
   QuarterCarParams quarter_car;          // rig quarter_car
   PneumaticRotaryParams pneumatic_rotary;  // rig pneumatic_rotary
   HalfCarParams half_car;                  // rig half_car

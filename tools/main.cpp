@@ -12,6 +12,8 @@
 #include "tools/diagnosis/diagnose_command.hpp"
 #include "tools/hidden_effects/make_run.hpp"
 #include "tools/bridge/bridge_command.hpp"
+#include "tools/identify/identify_command.hpp"
+#include "tools/tune/tune_command.hpp"
 #include "tools/runfile/log2csv.hpp"
 #include "tools/runfile/log2mcap.hpp"
 #include "tools/runfile/run_file_rig.hpp"
@@ -161,6 +163,50 @@ int main(int argc, char** argv) {
   opcmd_cmd->add_option("--wait-ack", opcmd.wait_ack_s, "Seconds to wait for the rig's reply; 0: do not wait")->capture_default_str();
   opcmd_cmd->add_option("--state-file", opcmd.state_path, "Sequence state file (default $XDG_STATE_HOME/rigctl/<sender>.seq)");
 
+  // Commissioning (issue 18): the loop's frequency response (docs/frf-files.md).
+  rigctl::IdentifyOptions ident;
+  std::string ident_excitation;
+  std::vector<double> ident_band;
+  double ident_amplitude = 0, ident_duration = 0, ident_resolution = 0, ident_op = 0, ident_settle = 0, ident_gain = 0;
+  auto* ident_cmd = app.add_subcommand("identify", "Measure the loop's and the plant's frequency response with an excitation about an operating point (docs/frf-files.md)");
+  ident_cmd->add_option("config", ident.config_path, "Rig config (YAML); its optional identify: section sets the defaults")->required()->check(CLI::ExistingFile);
+  ident_cmd->add_option("--case", ident.case_name, "Apply a named variant from the config's `cases:`");
+  ident_cmd->add_option("--out", ident.out_path, "FRF file to write (JSON)")->required();
+  ident_cmd->add_option("--plot", ident.plot_path, "Also plot the FRF with its coherence (PNG; needs matplotlib: setup.sh --plots)");
+  ident_cmd->add_option("--log", ident.log_path, "LCM log of the run (default: a new file in the config's log_dir)");
+  ident_cmd->add_option("--csv", ident.csv_path, "Run file of the run (default: next to the FRF, -run.csv)");
+  ident_cmd->add_flag("--fast", ident.fast, "Simulated plant only: simulated time, as fast as the CPU allows");
+  ident_cmd->add_flag("--no-realtime{false}", ident.realtime, "Do not try mlockall/SCHED_FIFO");
+  auto* ex_opt = ident_cmd->add_option("--excitation", ident_excitation, "Excitation: " + rigctl::known_kind_names<rigctl::ExcitationKind>());
+  auto* band_opt = ident_cmd->add_option("--band", ident_band, "Band LOW HIGH [Hz]")->expected(2);
+  auto* amp_opt = ident_cmd->add_option("--amplitude", ident_amplitude, "Peak of the excitation [feedback unit]; clamped by the rig's limits (default: the clamp)")->check(CLI::PositiveNumber);
+  auto* dur_opt = ident_cmd->add_option("--duration", ident_duration, "Excitation time [s], the first (settling) segment included")->check(CLI::PositiveNumber);
+  auto* res_opt = ident_cmd->add_option("--resolution", ident_resolution, "Frequency resolution [Hz]: one Welch segment lasts 1/resolution")->check(CLI::PositiveNumber);
+  auto* op_opt = ident_cmd->add_option("--operating-point", ident_op, "Demand held while exciting [feedback unit] (default: mid-stroke, the middle of safety.setpoint_range)");
+  auto* settle_opt = ident_cmd->add_option("--settle", ident_settle, "Hold at the operating point before the excitation [s]")->check(CLI::NonNegativeNumber);
+  auto* gain_opt = ident_cmd->add_option("--stabiliser-gain", ident_gain, "Replace the controller by a proportional one of this gain (PI: kp, P+V+dP: Ke): a rig without gains")->check(CLI::PositiveNumber);
+
+  rigctl::TuneOptions tune;
+  std::string tune_method = "frf";
+  double tune_bandwidth = 0;
+  auto* tune_cmd = app.add_subcommand("tune", "Gains for the rig's controller from a measured FRF (or a relay experiment), with predicted margins and step (docs/frf-files.md)");
+  tune_cmd->add_option("config", tune.config_path, "Rig config (YAML)")->required()->check(CLI::ExistingFile);
+  tune_cmd->add_option("--case", tune.case_name, "Apply a named variant from the config's `cases:`");
+  tune_cmd->add_option("--frf", tune.frf_path, "FRF file from rigctl identify")->check(CLI::ExistingFile);
+  tune_cmd->add_option("--method", tune_method, "frf: loop shaping on the FRF; relay: Astrom-Hagglund relay experiment, Ziegler-Nichols gains")->check(CLI::IsMember({"frf", "relay"}));
+  tune_cmd->add_option("--phase-margin", tune.target.phase_margin_deg, "Target phase margin [deg]")->capture_default_str()->check(CLI::Range(10.0, 89.0));
+  auto* bw_opt = tune_cmd->add_option("--bandwidth", tune_bandwidth, "Target crossover frequency [Hz] (default: the stiffest design with 6 dB gain margin and sensitivity peak 2)")->check(CLI::PositiveNumber);
+  tune_cmd->add_option("--out", tune.out_path, "Write the config with the tuned gains (YAML, comments kept)");
+  tune_cmd->add_option("--json", tune.json_path, "Write the design and its predictions (JSON)");
+  tune_cmd->add_option("--plot", tune.plot_path, "Bode plot of the measured plant and the tuned loop (PNG)");
+  tune_cmd->add_option("--evaluate", tune.evaluate_path, "Only measure a run of the config's standard step (rigctl run --csv): overshoot, settling, IAE")->check(CLI::ExistingFile);
+  tune_cmd->add_option("--relay-amplitude", tune.relay.amplitude, "Relay output about the hold command [command unit] (default: a tenth of the output limit)")->check(CLI::PositiveNumber);
+  tune_cmd->add_option("--relay-hysteresis", tune.relay.hysteresis, "Relay hysteresis [feedback unit] (default: 3 x the sensor noise)")->check(CLI::PositiveNumber);
+  tune_cmd->add_option("--relay-duration", tune.relay.duration_s, "Relay time [s]")->capture_default_str()->check(CLI::PositiveNumber);
+  tune_cmd->add_option("--log", tune.relay.log_path, "LCM log of the relay run");
+  tune_cmd->add_flag("--fast", tune.relay.fast, "Relay on a simulated plant: simulated time");
+  tune_cmd->add_flag("--no-realtime{false}", tune.relay.realtime, "Do not try mlockall/SCHED_FIFO");
+
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -171,6 +217,29 @@ int main(int argc, char** argv) {
       install_stop_handlers();
       const auto report = rigctl::run_rig(run, g_stop, std::cout);
       return report.loop.final_state == rigctl::RigState::kFaulted ? 3 : 0;
+    }
+    if (ident_cmd->parsed()) {
+      auto& st = ident.settings;
+      if (ex_opt->count() > 0) st.excitation = rigctl::parse_kind<rigctl::ExcitationKind>(ident_excitation);
+      if (band_opt->count() > 0) {
+        st.band_min_hz = ident_band[0];
+        st.band_max_hz = ident_band[1];
+      }
+      if (amp_opt->count() > 0) st.amplitude = ident_amplitude;
+      if (dur_opt->count() > 0) st.duration_s = ident_duration;
+      if (res_opt->count() > 0) st.resolution_hz = ident_resolution;
+      if (op_opt->count() > 0) st.operating_point = ident_op;
+      if (settle_opt->count() > 0) st.settle_s = ident_settle;
+      if (gain_opt->count() > 0) st.stabiliser_gain = ident_gain;
+      install_stop_handlers();
+      return rigctl::run_identify(ident, g_stop, std::cout).aborted ? 3 : 0;
+    }
+    if (tune_cmd->parsed()) {
+      tune.method = rigctl::parse_kind<rigctl::TuneMethod>(tune_method);
+      if (bw_opt->count() > 0) tune.target.crossover_hz = tune_bandwidth;
+      install_stop_handlers();
+      rigctl::run_tune(tune, g_stop, std::cout);
+      return 0;
     }
     if (sim_cmd->parsed()) {
       if (sim_duration_opt->count() > 0) sim.duration_s = sim_duration;

@@ -225,6 +225,8 @@ std::unique_ptr<Controller> make_controller(const RigConfig& c, const ChannelLay
   throw std::logic_error("make_controller: controller kind out of range");
 }
 
+}  // namespace
+
 std::unique_ptr<FilteredProfile> make_profile(const RigConfig& c, double& duration) {
   const auto& p = c.profile;
   std::unique_ptr<SetpointProfile> raw;
@@ -250,6 +252,8 @@ std::unique_ptr<FilteredProfile> make_profile(const RigConfig& c, double& durati
   duration = raw->duration();
   return std::make_unique<FilteredProfile>(std::move(raw), p.filter_tau_s, c.loop.period_s);
 }
+
+namespace {
 
 // Order matters: the first of the most severe trips names why a run ended.
 // Plausibility of every input first, then `limits:`, then `safety.detectors`

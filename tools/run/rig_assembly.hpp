@@ -34,6 +34,10 @@ AssembledRig assemble_rig(const RigConfig& config);
 // `rigctl rig-sim` both step one).
 std::unique_ptr<SimulatedPlant> make_plant(const RigConfig& config);
 
+// The config's demand: its profile through its first-order filter, and the
+// profile's natural length.
+std::unique_ptr<FilteredProfile> make_profile(const RigConfig& config, double& duration);
+
 // Run-file name of the demand for a rig kind ("x_ref" for quarter_car).
 std::string setpoint_name_for(RigKind rig);
 

@@ -102,6 +102,12 @@ RunReport run_rig(const RunOptions& options, const std::atomic<bool>& stop, std:
 
 RunReport run_rig(const RigConfig& config, const RunOptions& options, const std::atomic<bool>& stop, std::ostream& out) {
   AssembledRig rig = assemble_rig(config);
+  if (options.profile_override) {
+    auto raw = options.profile_override();
+    rig.profile_duration_s = raw->duration();
+    rig.profile = std::make_unique<FilteredProfile>(std::move(raw), 0.0, config.loop.period_s);
+  }
+  if (options.controller_override) rig.controller = options.controller_override(rig.driver->layout());
   if (options.fast && !rig.driver->simulated()) {
     throw std::runtime_error("--fast needs a simulated driver: '" + std::string(to_string(config.driver)) + "' runs real hardware in real time");
   }
@@ -261,8 +267,8 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
   report.loop = result;
 
   const auto& t = result.timing;
-  out << "  ended: " << to_string(result.final_state) << " (" << end_reason(result.end_event, meta.layout, *rig.driver)
-      << ") after " << result.ticks << " ticks ("
+  report.end_reason = end_reason(result.end_event, meta.layout, *rig.driver);
+  out << "  ended: " << to_string(result.final_state) << " (" << report.end_reason << ") after " << result.ticks << " ticks ("
       << std::fixed << std::setprecision(3) << static_cast<double>(result.ticks) * config.loop.period_s
       << " s rig time, " << report.wall_s << " s wall), rig state " << to_string(result.final_safety_state) << "\n";
   if (!options.fast) {

@@ -3,6 +3,8 @@
 #pragma once
 
 #include <atomic>
+#include <functional>
+#include <memory>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -13,6 +15,9 @@
 #include "drivers/sim/fault_spec.hpp"
 #include "rt/comms/telemetry_tap.hpp"
 #include "tools/run/ws_endpoint.hpp"
+#include "rt/control/controller.hpp"
+#include "rt/control/setpoint_profile.hpp"
+#include "rt/sample.hpp"
 
 namespace rigctl {
 
@@ -43,6 +48,14 @@ struct RunOptions {
   // Further consumers of every telemetry message, called before the Foxglove
   // server's feed (rigctl bench: the time each message left the publisher).
   std::vector<TelemetryTap*> telemetry_taps;
+  // Parts that replace the config's, for the commissioning commands
+  // (rigctl identify, rigctl tune --method relay): the demand (an excitation
+  // about an operating point, applied unfiltered; its length is the run's
+  // default length) and the controller (a relay experiment), built for the
+  // assembled rig's channels. Everything else, the safety machinery above
+  // all, is the config's.
+  std::function<std::unique_ptr<SetpointProfile>()> profile_override;
+  std::function<std::unique_ptr<Controller>(const ChannelLayout&)> controller_override;
 };
 
 struct RunReport {
@@ -50,6 +63,7 @@ struct RunReport {
   std::string log_path;
   std::string csv_path;
   std::string events_path;
+  std::string end_reason;  // why the run ended, e.g. "sensor_stuck: x_r = 0.0348"
   double wall_s = 0.0;
 };
 

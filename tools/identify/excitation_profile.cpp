@@ -1,0 +1,24 @@
+#include "tools/identify/excitation_profile.hpp"
+
+#include <cmath>
+
+namespace rigctl {
+
+ExcitationProfile::ExcitationProfile(LeadIn lead_in, double settle_s, std::vector<double> excitation,
+                                     double period_s, double tail_s)
+    : lead_in_(lead_in), settle_s_(settle_s), excitation_(std::move(excitation)), period_s_(period_s),
+      tail_s_(tail_s) {}
+
+double ExcitationProfile::at(double t) const noexcept {
+  const double t_excitation = t - excitation_start_s();
+  if (t_excitation < 0.0) return lead_in_.at(t);
+  // Profile times are whole ticks (nanosecond integers): round, do not floor.
+  const auto i = static_cast<std::size_t>(std::llround(t_excitation / period_s_));
+  return lead_in_.target + (i < excitation_.size() ? excitation_[i] : 0.0);
+}
+
+double ExcitationProfile::duration() const noexcept {
+  return excitation_start_s() + static_cast<double>(excitation_.size()) * period_s_ + tail_s_;
+}
+
+}  // namespace rigctl

@@ -1,0 +1,33 @@
+// The demand of an identification run: the config's lead-in to the
+// operating point (from where the rig stands when `start: measured`), a
+// settling hold there, the excitation table added to it tick by tick, then
+// the operating point again until the run's controlled stop.
+#pragma once
+
+#include <vector>
+
+#include "rt/control/setpoint_profile.hpp"
+
+namespace rigctl {
+
+class ExcitationProfile final : public SetpointProfile {
+ public:
+  // lead_in.target is the operating point; excitation: one value per tick.
+  ExcitationProfile(LeadIn lead_in, double settle_s, std::vector<double> excitation, double period_s,
+                    double tail_s);
+  double at(double t) const noexcept override;
+  double duration() const noexcept override;
+  void start_from(double position) noexcept override { lead_in_.rebase(position); }
+
+  double operating_point() const noexcept { return lead_in_.target; }
+  double excitation_start_s() const noexcept { return lead_in_.duration() + settle_s_; }
+
+ private:
+  LeadIn lead_in_;
+  double settle_s_;
+  std::vector<double> excitation_;
+  double period_s_;
+  double tail_s_;
+};
+
+}  // namespace rigctl
