@@ -99,7 +99,7 @@ AppliedEffect truth_of(const std::string& cause, double level) {
   const auto& gen = effect_generator(RigKind::kPneumaticRotary);
   RigConfig c = load_rig_config(kConfig, gen.excitation_case);
   gen.make_clean(c);
-  return gen.apply(c, cause, level);
+  return gen.apply(c, cause, level, 0);
 }
 
 double param(const diag::CauseResult& c, const std::string& name) {
