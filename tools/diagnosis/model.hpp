@@ -27,6 +27,11 @@ struct ParamSpec {
   double null = 0.0;   // value at which the effect vanishes (unused for baseline parameters)
   std::vector<double> starts;  // extra start values for a non-convex scalar (grid in the screening)
   bool strength = false;       // the significance test of the effect uses this parameter
+  // Baseline parameters a real rig is uncertain about: the stated tolerance,
+  // the prior's standard deviation as a fraction of `init` (the nominal). The
+  // fit is regularised toward the nominal by it, so a parameter the run does
+  // not excite stays put and is reported as undetermined. 0: no prior.
+  double prior = 0.0;
 };
 
 struct EffectSpec {
