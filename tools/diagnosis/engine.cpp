@@ -83,6 +83,7 @@ std::vector<Candidate> screen(const Workspace& w, const Scored& current, const s
     if (w.effects[e].stub || std::find(active.begin(), active.end(), e) != active.end()) continue;
     w.say("round " + std::to_string(round) + ": screening " + w.effects[e].cause);
     std::vector<bool> free = w.free_for({});
+    for (std::size_t i = 0; i < w.n_base; ++i) free[i] = w.model.couples(i, w.effects[e].cause);
     for (std::size_t j = 0; j < w.effects[e].params.size(); ++j) free[w.offset[e] + j] = true;
     Candidate best;
     best.effect = e;
@@ -258,8 +259,10 @@ void backward_check(const Workspace& w, std::vector<std::size_t>& active, Scored
   }
 }
 
-// No cause, but a channel whose held-out residual is well above its noise
-// floor and its fit below 98 %: the model is wrong in a way nobody named.
+// No cause, but a channel whose held-out residual is four times its noise
+// floor or more (and its fit below 99.5 %, so a channel measured far more
+// finely than it moves does not count): the model is wrong in a way nobody
+// named.
 void check_unexplained(const Workspace& w, const Scored& current, Diagnosis& d) {
   if (!d.causes.empty()) return;
   const double dt = w.n > 1 ? (w.model.time().back() - w.model.time().front()) / static_cast<double>(w.n - 1) : 1.0;
@@ -271,7 +274,7 @@ void check_unexplained(const Workspace& w, const Scored& current, Diagnosis& d) 
     const double rms = std::sqrt(ss / static_cast<double>(std::max<std::size_t>(1, w.n - w.val_begin)));
     const double noise = noise_floor(w.outs()[o].measured);
     const double excess = noise > 0.0 ? rms / noise : 0.0;
-    if (current.fit[o] < 98.0 && excess > 3.0 && excess > worst) {
+    if (current.fit[o] < 99.5 && excess > 4.0 && excess > worst) {
       worst = excess;
       const Band band = power_band(e, dt, w.val_begin, w.n);
       d.unexplained = true;

@@ -166,6 +166,17 @@ class QuarterCarModel : public RigModel {
          "effective bulk modulus beta_ratio x nominal (air in the oil), constant"},
     };
   }
+  // Suspension causes move only the suspension's parameters (the tyre and
+  // masses are in both); actuator causes only the actuator's; lift-off both.
+  bool couples(std::size_t index, const std::string& cause) const override {
+    static const char* kSuspensionCauses[] = {"bearing_friction", "damper_asymmetry", "sensor_delay", "sensor_offset"};
+    const bool suspension_param = index <= kBt;
+    const bool shared = index >= kMb && index <= kBt;
+    for (const char* c : kSuspensionCauses)
+      if (cause == c) return suspension_param;
+    if (cause == "tyre_liftoff") return true;
+    return !suspension_param || shared;
+  }
   std::string replay() const override {
     return "two sub-models: the actuator by closed-loop replay (x_ref through the rig's PI controller, servovalve "
            "and actuator, 5 RK4 sub-steps per period, tyre load over the measured wheel motion: outputs u, x_r, p1, "
