@@ -150,7 +150,10 @@ class PneumaticRotaryModel : public RigModel {
     // dither amplitude), so a rig a few per cent off nominal is calibrated
     // before any effect is credited with the difference.
     const auto& p = p_;
-    return {P("I", "kg m^2", p.inertia, 0.02, 50.0, p.inertia),
+    // The payload: the least certain value (the paper runs 1.7 and 0.4 kg m^2
+    // on one rig), so a wide prior of 30 %: a strong effect must not be able
+    // to drag it to its bound before any candidate is tried.
+    return {Prior("I", "kg m^2", p.inertia, 0.30, 0.05, 20.0),
             P("b", "N m s/rad", 0.0, 0.0, 100.0, 0.5),
             Prior("C1", "kg/(s m)", p.flow_gain, 0.05),
             Prior("C2", "kg/(s Pa)", p.flow_pressure_coefficient, 0.05),
