@@ -45,8 +45,11 @@ Scored calibrate_baseline(Workspace& w, Diagnosis& d) {
   w.prior_weight = w.residual_variance(nominal);
   const auto free = w.free_for({});
   Scored base = w.fit(nominal.theta, free, 60, false);
+  const int first_iterations = base.iterations;
   w.prior_weight = w.residual_variance(base);
   base = w.fit(base.theta, free, 60, true);
+  w.say("calibrated in " + std::to_string(first_iterations) + " + " + std::to_string(base.iterations) +
+        " iterations");
   for (std::size_t i = 0; i < w.n_base; ++i) {
     const auto& sp = w.specs[i];
     Calibrated c{sp.name, sp.unit, sp.init, base.theta[i], base.sigma[i], sp.prior, !base.undetermined[i], false};
@@ -164,6 +167,7 @@ std::vector<Candidate> refit_best(const Workspace& w, std::vector<Candidate> scr
     // free; the others stay where the calibration put them (their
     // sub-model's outputs do not change with the candidate).
     r.s = fit_coupled(w, screened[c].s.theta, act, 30, current);
+    w.say("  " + sc.cause + ": refitted in " + std::to_string(r.s.iterations) + " iterations");
     r.gain = -1e9;
     for (std::size_t o = 0; o < w.outs().size(); ++o)
       if (r.s.fit[o] - current.fit[o] > r.gain) r.gain = r.s.fit[o] - current.fit[o], r.signal = o;

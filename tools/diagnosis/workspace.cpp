@@ -70,6 +70,7 @@ Scored Workspace::fit(const std::vector<double>& start, const std::vector<bool>&
   Scored s = score(r.theta);
   s.sigma = r.sigma;
   s.undetermined = r.undetermined;
+  s.iterations = r.iterations;
   return s;
 }
 

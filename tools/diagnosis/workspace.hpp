@@ -21,6 +21,7 @@ struct Scored {
   std::vector<std::vector<double>> y;
   std::vector<double> fit;  // per output, held-out fit percent
   double est_sse = 0.0;     // weighted data residuals on the estimation part (no prior terms)
+  int iterations = 0;       // of the fit that made it (progress and timing)
 };
 
 class Workspace {

@@ -256,7 +256,7 @@ class QuarterCarModel : public RigModel {
       for (int s = 0; s < sub; ++s) {
         const double xr = xr0 + (xr1 - xr0) * (s + 0.5) / sub;
         const double vrel = vw - vb;
-        const double fs = ks * (xw - xb) + (bd + dc * std::tanh(vrel / 0.01)) * vrel;
+        const double fs = ks * (xw - xb) + (dc != 0.0 ? bd + dc * std::tanh(vrel / 0.01) : bd) * vrel;
         const double ft = tyre_contact(f0 + kt * (xr - xw) + bt * (vr - vw), uni) - f0;  // static part removed
         vw += h * (ft - fs) / mw;
         xw += h * vw;
@@ -303,7 +303,10 @@ class QuarterCarModel : public RigModel {
     if (a.p2 <= p.cavitation_pressure && d.p2 < 0.0) d.p2 = 0.0;
     const double f0 = (th[kMb] + th[kMw]) * p.gravity;
     const double f_tyre = tyre_contact(f0 + th[kKt] * (a.xr - xw) + th[kBt] * (a.vr - vw), th[kUni]);
-    const double seal = (th[kSealPr] + th[kSealPc] * std::max(0.0, a.p1 + a.p2)) * std::tanh(a.vr / 0.02);
+    // tanh (through expm1) was half the replay's time when profiled: it is
+    // computed only when the seal friction is in.
+    const double seal_level = th[kSealPr] + th[kSealPc] * std::max(0.0, a.p1 + a.p2);
+    const double seal = seal_level != 0.0 ? seal_level * std::tanh(a.vr / 0.02) : 0.0;
     d.xr = a.vr;
     d.vr = (a.p1 * a1 - a.p2 * a2 - th[kBvr] * a.vr - f_tyre - p.mass_rod * p.gravity - seal) / p.mass_rod;
   }
