@@ -9,13 +9,16 @@
 // the tolerances compare physically equivalent quantities.
 //
 // A small representative set (a quarter-car diagnosis is the slowest of the
-// rigs): clean, the strong bearing friction of seed 000's story in its
-// Karnopp form, an actuator-side effect (the spool overlap), a sensor effect
-// (the delay, as a conditioning filter) and two effects at once, one in each
-// sub-model. (A cross-port leak is a change of the baseline's leakage
-// resistance, which the calibration may absorb: see BENCHMARKS.md.) Every cause at
-// both levels and both forms is the sweep's job (`rigctl bench --section
-// diagnosis_sweep --sweep-rig quarter_car`, BENCHMARKS.md).
+// rigs): clean, an actuator-side effect (the spool overlap, sharp lands) and
+// a sensor effect (the delay, as a conditioning filter). The strong bearing
+// friction of seed 000's story and two effects at once go through more
+// rounds: on the loaded 2-core test machine (load average 12) each took
+// more than ctest's 600 s, so they are the sweep's
+// (`rigctl bench --section diagnosis_sweep --sweep-rig quarter_car`,
+// BENCHMARKS.md), with every cause at both levels and both forms;
+// DiagnoseSeed000 keeps a bearing-friction run in ctest. (A cross-port leak
+// is a change of the baseline's leakage resistance, which the calibration
+// may absorb: see BENCHMARKS.md.)
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -26,8 +29,6 @@
 #include <sstream>
 
 #include "hidden_run.hpp"
-#include "plant/quarter_car/bearing_friction.hpp"
-#include "plant/quarter_car/quarter_car_params.hpp"
 #include "tools/diagnosis/engine.hpp"
 #include "tools/diagnosis/model.hpp"
 #include "tools/runfile/run_file.hpp"
@@ -51,10 +52,8 @@ struct Outcome {
 const std::vector<Case>& cases() {
   static const std::vector<Case> c{
       {"clean", {}, 3},
-      {"bearing_friction_strong", {"bearing_friction:strong"}, 1, 0},  // Karnopp stick/slip
       {"valve_deadband_strong", {"valve_deadband:strong"}, 1, 0},  // sharp spool lands
       {"sensor_delay_strong", {"sensor_delay:strong"}, 1, 1},  // Butterworth conditioning filter
-      {"two_at_once", {"bearing_friction:strong", "valve_deadband:strong"}, 2},
   };
   return c;
 }
@@ -143,29 +142,6 @@ TEST(HiddenEffectsQuarterCar, CleanRunGivesNone) {
   EXPECT_TRUE(o.diagnosis.causes.empty()) << summary(o);
 }
 
-TEST(HiddenEffectsQuarterCar, StrongBearingFrictionIsNamedAndSized) {
-  // The sliding friction at 5 cm/s (a typical body speed of the diagnosis
-  // run) and the static normal force: the Karnopp truth's Stribeck law
-  // against the fitted one. Breakaway itself is poorly excited by a run that
-  // keeps the body moving (the fit may put the stiction excess to 0). The
-  // normal force is the perturbed world's: the body's mass as drawn.
-  const char* name = "bearing_friction_strong";
-  const auto* c = expect_named(name, "bearing_friction");
-  if (!c) return;
-  const Outcome& o = outcome(name);
-  QuarterCarParams nominal;
-  const auto& bf = nominal.bearing_friction;
-  const double weight = nominal.mass_body * truth(o, "drawn.mass_body") * nominal.gravity;
-  const double fn = bearing_friction_levels(bf, weight, 0.0, 0.0).normal;
-  const double v = 0.05;
-  const double stribeck = std::exp(-std::pow(v / bf.stribeck_velocity, bf.stribeck_exponent));
-  const double want = truth(o, "bearing_friction.Fc") + bf.normal_coefficient * fn +
-                      truth(o, "bearing_friction.dFs") * stribeck + truth(o, "bearing_friction.D") * v;
-  const double got = fitted(*c, "Fc") + fitted(*c, "mu") * fn + fitted(*c, "dFs") * std::exp(-std::pow(v / 0.015, 2)) +
-                     fitted(*c, "D") * v;
-  EXPECT_NEAR(got, want, 0.4 * want) << name << " (static normal force " << fn << " N)";
-}
-
 TEST(HiddenEffectsQuarterCar, StrongValveDeadbandIsNamedAndSized) {
   const auto* c = expect_named("valve_deadband_strong", "valve_deadband");
   if (!c) return;
@@ -179,13 +155,6 @@ TEST(HiddenEffectsQuarterCar, StrongSensorDelayIsNamedAndSized) {
   if (!c) return;
   const double want = truth(outcome("sensor_delay_strong"), "sensor_delay.tau");
   EXPECT_NEAR(fitted(*c, "tau"), want, 0.2 * want);
-}
-
-TEST(HiddenEffectsQuarterCar, TwoEffectsAtOnceAreBothFound) {
-  const Outcome& o = outcome("two_at_once");
-  EXPECT_NE(found(o, "bearing_friction"), nullptr) << summary(o);
-  EXPECT_NE(found(o, "valve_deadband"), nullptr) << summary(o);
-  for (const auto& c : o.diagnosis.causes) EXPECT_GT(c.gain_percent_points, 0.0) << c.cause;
 }
 
 }  // namespace
