@@ -12,8 +12,9 @@
 // rigs): clean, an actuator-side effect (the spool overlap, sharp lands) and
 // a sensor effect (the delay, as a conditioning filter). The strong bearing
 // friction of seed 000's story and two effects at once go through more
-// rounds: on the loaded 2-core test machine (load average 12) each took
-// more than ctest's 600 s, so they are the sweep's
+// rounds: on the loaded 2-core test machine (load average 12) the first
+// took more than ctest's 600 s, the second passed in 405 s, both far over
+// a test's budget, so they are the sweep's
 // (`rigctl bench --section diagnosis_sweep --sweep-rig quarter_car`,
 // BENCHMARKS.md), with every cause at both levels and both forms;
 // DiagnoseSeed000 keeps a bearing-friction run in ctest. (A cross-port leak
