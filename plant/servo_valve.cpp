@@ -1,5 +1,6 @@
 #include "plant/servo_valve.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace rigctl {
@@ -21,6 +22,23 @@ ValveFlows valve_flows(double spool, double p1, double p2, double flow_gain,
     q.q1 = k * orifice_root(p1, laminar_pressure);
   }
   return q;
+}
+
+double overlapped_spool(double x, double overlap, double r) {
+  if (overlap <= 0.0) return x;
+  const double a = std::abs(x);
+  double open;
+  if (r <= 0.0) {
+    open = std::max(0.0, a - overlap);
+  } else if (a <= overlap - r) {
+    open = 0.0;
+  } else if (a >= overlap + r) {
+    open = a - overlap;
+  } else {
+    const double s = a - overlap + r;  // 0 .. 2r
+    open = s * s / (4.0 * r);
+  }
+  return std::copysign(open, x);
 }
 
 }  // namespace rigctl

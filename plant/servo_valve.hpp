@@ -21,4 +21,10 @@ struct ValveFlows {
 ValveFlows valve_flows(double spool, double p1, double p2, double flow_gain,
                        double supply_pressure, double laminar_pressure);
 
+// Spool opening of an overlapped spool (any unit of travel): sharp (no
+// metering inside +-overlap) when edge_radius is 0, else rounded metering
+// edges, a quadratic blend over +-edge_radius about the overlap
+// (C1-continuous). overlap <= 0: the critically lapped spool, x itself.
+double overlapped_spool(double x, double overlap, double edge_radius);
+
 }  // namespace rigctl

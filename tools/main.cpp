@@ -125,6 +125,7 @@ int main(int argc, char** argv) {
   bench_cmd->add_flag("--quick", bench.quick, "Seconds instead of minutes: checks that every section runs (rough numbers)");
   bench_cmd->add_option("--json", bench.json_path, "Write every result to this JSON file");
   bench_cmd->add_option("--config-dir", bench.config_dir, "Folder with quarter_car.yaml and pneumatic_rotary.yaml (default: config)")->check(CLI::ExistingDirectory);
+  bench_cmd->add_option("--sweep-rig", bench.sweep_rig, "diagnosis_sweep: only this rig kind");
   bench_cmd->add_option("--section", bench.sections, "Run only this section; repeatable")->check(CLI::IsMember(rigctl::bench_section_names()));
 
   rigctl::DiagnoseCommandOptions diag;
@@ -147,7 +148,11 @@ int main(int argc, char** argv) {
   make_cmd->add_option("--case", make.case_name, "Excitation case of the config (default: the rig's diagnosis case)");
   make_cmd->add_option("--effect", effect_texts, "CAUSE[:weak|strong|LEVEL], repeatable; none or absent: a clean run");
   make_cmd->add_option("--duration", make.duration_s, "Run length [s] (default: the profile's)");
-  make_cmd->add_option("--seed", make.seed, "Sensor-noise seed");
+  make_cmd->add_option("--seed", make.seed, "Seed of the sensor noise, the parameter draw and (without --form) the form");
+  make_cmd->add_option("--tolerance", make.tolerance,
+                       "Half-width of every plant parameter's draw, a fraction (default 0.05: +-5 %); 0: nominal plant, "
+                       "nominal controller and demand");
+  make_cmd->add_option("--form", make.form, "Physical form of the effects, 0 or 1 (default: seed % 2)");
   make_cmd->add_option("--out", make.out_csv, "Run file to write (CSV)")->required();
   make_cmd->add_option("--truth", make.truth_json, "Write what was hidden (JSON)");
 

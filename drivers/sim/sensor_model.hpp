@@ -17,6 +17,9 @@ struct SensorSpec {
   // driver interpolates a history of the true signal (cubic, so that it is
   // not the linear interpolation the diagnosis fits). 0 = none.
   double delay_s = 0.0;
+  // [Hz] cut-off of a second-order Butterworth conditioning filter on the
+  // true signal (drivers/sim/conditioning_filter.hpp); 0 = none.
+  double filter_hz = 0.0;
 };
 
 // A standard normal draw by Box-Muller, by hand: std::normal_distribution
@@ -38,6 +41,7 @@ class SensorModel {
   double measure(double truth, std::mt19937_64& rng) const noexcept;
   double lsb() const noexcept { return lsb_; }
   double delay_s() const noexcept { return spec_.delay_s; }
+  double filter_hz() const noexcept { return spec_.filter_hz; }
 
  private:
   SensorSpec spec_;

@@ -19,7 +19,9 @@ SimDriver::SimDriver(std::unique_ptr<SimulatedPlant> plant, std::vector<SensorSp
     if (!(s.delay_s >= 0.0)) throw std::invalid_argument("sensor delay must be >= 0 s");
     sensor_specs_.push_back(s);
     sensors_.emplace_back(s);
+    if (!(s.filter_hz >= 0.0)) throw std::invalid_argument("sensor filter cut-off must be >= 0 Hz");
     delays_.emplace_back(s.delay_s, period_s);
+    filters_.emplace_back(s.filter_hz, period_s);
   }
   for (auto d : dacs) {
     d.noise_sd = 0.0;  // a DAC quantises and clips; its noise belongs to the plant
@@ -34,6 +36,7 @@ void SimDriver::start() {
   rng_.seed(seed_);
   command_ = safe_command_;
   for (std::size_t i = 0; i < delays_.size(); ++i) delays_[i] = DelayLine(sensors_[i].delay_s(), period_s_);
+  for (std::size_t i = 0; i < filters_.size(); ++i) filters_[i] = ConditioningFilter(sensors_[i].filter_hz(), period_s_);
   tick_ = 0;
   started_ = false;
   faults_.reset();
@@ -70,7 +73,8 @@ bool SimDriver::read(Sample& out) {
   out.t_ns = tick_ * period_ns_;
   out.status = 0;
   for (std::size_t i = 0; i < truth_.size(); ++i) {
-    const double seen = delays_[i].active() ? delays_[i].push(truth_[i]) : truth_[i];
+    const double conditioned = filters_[i].active() ? filters_[i].push(truth_[i]) : truth_[i];
+    const double seen = delays_[i].active() ? delays_[i].push(conditioned) : conditioned;
     out.value[i] = sensors_[i].measure(seen, rng_);
   }
   if (!faults_.empty()) faults_.apply_to_sample(tick_, out);

@@ -10,6 +10,7 @@
 #include <random>
 #include <vector>
 
+#include "drivers/sim/conditioning_filter.hpp"
 #include "drivers/sim/delay_line.hpp"
 #include "rt/driver.hpp"
 #include "drivers/sim/sensor_model.hpp"
@@ -53,6 +54,7 @@ class SimDriver final : public Driver {
   std::vector<SensorSpec> sensor_specs_;
   std::vector<SensorModel> sensors_;
   std::vector<DelayLine> delays_;  // per signal; inactive where the spec has no delay
+  std::vector<ConditioningFilter> filters_;  // per signal; inactive where the spec has no filter
   std::vector<SensorModel> dacs_;
   ChannelLayout layout_;
   double period_s_;

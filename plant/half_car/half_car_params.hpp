@@ -48,6 +48,9 @@ struct HalfCarParams {
   // Optional effects (nominal off), for the diagnosis causes of
   // docs/run-files.md 2.5. The linear model of eq. 5 ignores them.
   double damper_rebound_factor = 1.0;  // rebound (extension) damping / compression damping; 1 = linear damper
+  // [m/s] knee of a digressive damper (the second form of asymmetry): above
+  // it the rebound force grows at a third of its low-speed rate; 0 = linear.
+  double damper_rebound_knee = 0.0;
   double actuator_time_constant = 0.0; // [s] first-order lag of the active force behind its command; 0 = ideal
   // [s] a second, faster lag ahead of the first (the servo-valve spool
   // feeding the force loop): with it the actuator is second order, force

@@ -92,6 +92,17 @@ double HalfCarPlant::tyre_force_at(const Vec& y, int wheel, double t) const {
   return std::max(0.0, static_load_[k] + kt * (r.z - zu) + ct * (r.dz - y[kVu1 + k]));
 }
 
+// Rebound (rate > 0) damping is damper_rebound_factor times compression;
+// past damper_rebound_knee the rebound force grows at a third of that rate
+// (a digressive valve opening).
+double HalfCarPlant::damper_force(double c, double rate) const {
+  const auto& p = params_;
+  if (rate <= 0.0) return c * rate;
+  const double cr = c * p.damper_rebound_factor, knee = p.damper_rebound_knee;
+  if (knee <= 0.0 || rate <= knee) return cr * rate;
+  return cr * (knee + (rate - knee) / 3.0);
+}
+
 void HalfCarPlant::derivatives(const Vec& y, double t, const Command2& u, Vec& dy) const {
   const auto& p = params_;
   const double k[2] = {p.spring_1, p.spring_2};
@@ -104,9 +115,7 @@ void HalfCarPlant::derivatives(const Vec& y, double t, const Command2& u, Vec& d
     const double l = lever_[i];
     const double travel = y[kZs] + l * y[kPhi] - y[kZu1 + i];
     const double rate = y[kVs] + l * y[kOmega] - y[kVu1 + i];
-    const double damping = rate > 0.0 ? c[i] * p.damper_rebound_factor : c[i];
-    // Force of corner i on the body (up positive); the wheel gets its negative.
-    const double f_body = -k[i] * travel - damping * rate + y[kF1 + i];
+    const double f_body = -k[i] * travel - damper_force(c[i], rate) + y[kF1 + i];
     heave += f_body;
     moment += l * f_body;
     // The tyre's change from its static load; the static loads balance gravity.

@@ -123,6 +123,7 @@ class HalfCarPlant : public SimulatedPlant {
   // What holding u does to the state at once: an ideal actuator (no lag) is
   // the command, a missing valve stage passes it.
   void hold_command(const Command2& u, Vec& y) const;
+  double damper_force(double c, double rate) const;  // [N] of a corner's damper at suspension rate
   void derivatives(const Vec& y, double t, const Command2& u, Vec& dy) const;
 
  private:

@@ -22,6 +22,31 @@ struct CoulombBrakeParams {
   double level = 0.0;  // as a fraction of max torque (the paper uses 2, 6, 8, 10 %)
 };
 
+// Second physical forms of the effects, for the hidden-effect generator
+// (tools/hidden_effects/pneumatic_rotary.cpp): each differs in shape from
+// both the plant's first form and the diagnosis candidate. All off by default.
+struct PneumaticHiddenForms {
+  // Loop-shaped (Bouc-Wen) bladder hysteresis: torque H z with
+  // dz/dtheta = (1 - (0.5 sign(omega z) + 0.5) |z|^n) / angle; after a
+  // reversal z ramps linearly, then bends smoothly into saturation at 1.
+  double bouc_wen_level = 0.0;       // H as a fraction of max torque; 0: off
+  double bouc_wen_angle = 0.02;      // [rad] initial slope angle (H / angle N m/rad)
+  double bouc_wen_exponent = 1.5;    // n: the sharpness of the bend
+  // Smooth (Simscape rotational) friction: Stribeck peak ratio 1.3 at
+  // 0.02 rad/s, Coulomb tanh over 4 mrad/s; no stick/slip state.
+  double smooth_friction_level = 0.0;  // Coulomb level as a fraction of max torque; 0: off
+  // Heat transfer: the exponent goes from n_slow at rest to gamma at speed,
+  // n = n_slow + (gamma - n_slow) |omega| / (|omega| + corner).
+  double polytropic_slow = 0.0;        // n at rest; 0: off (constant gamma)
+  double polytropic_corner_speed = 0.3;  // [rad/s]
+  // Mechanical null shift of the spool [m] after the dither (the electrical
+  // form is valve_null_offset [V] before it): the spool limit is reached
+  // sooner on one side.
+  double spool_null_shift = 0.0;
+  // Rounded metering edges of the overlapped spool [m]; 0: sharp lands.
+  double overlap_edge_radius = 0.0;
+};
+
 struct PneumaticRotaryParams {
   // Valve: spool proportional to solenoid voltage via offset, gain, saturation.
   double solenoid_gain = 0.161e-3;    // [m/V]: +-5 V gives +-0.81 mm
@@ -55,6 +80,7 @@ struct PneumaticRotaryParams {
 
   BladderHysteresisParams hysteresis;
   CoulombBrakeParams brake;
+  PneumaticHiddenForms forms;
 
   // RK4 sub-steps per control period: 0.25 ms at 2.5 ms, set by the 50 Hz dither.
   int substeps = 10;

@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include "plant/pneumatic_rotary/coulomb_friction.hpp"
+#include "plant/servo_valve.hpp"
 
 namespace rigctl {
 
@@ -34,6 +35,29 @@ PneumaticRotaryPlant::PneumaticRotaryPlant(const PneumaticRotaryParams& params)
 void PneumaticRotaryPlant::reset() {
   set_state(PneumaticRotaryState{});
   u_ = 0.0;
+  bouc_wen_z_ = 0.0;
+}
+
+double PneumaticRotaryPlant::hidden_torque(double omega) const {
+  const auto& f = params_.forms;
+  double t = 0.0;
+  if (f.bouc_wen_level > 0.0) t += f.bouc_wen_level * params_.max_torque * bouc_wen_z_;
+  if (f.smooth_friction_level > 0.0) {
+    constexpr double kBreakawayRatio = 1.3, kBreakawaySpeed = 0.02, kCoulombSpeed = 0.004;  // [1, rad/s, rad/s]
+    const double fc = f.smooth_friction_level * params_.max_torque;
+    const double v_st = kBreakawaySpeed * std::numbers::sqrt2;
+    t += std::sqrt(2.0 * std::numbers::e) * (kBreakawayRatio - 1.0) * fc * std::exp(-(omega / v_st) * (omega / v_st)) *
+             omega / v_st +
+         fc * std::tanh(omega / kCoulombSpeed);
+  }
+  return t;
+}
+
+double PneumaticRotaryPlant::polytropic_scale(double omega) const {
+  const auto& f = params_.forms;
+  if (!(f.polytropic_slow > 0.0)) return 1.0;
+  const double g = params_.heat_capacity_ratio, w = std::abs(omega);
+  return (f.polytropic_slow + (g - f.polytropic_slow) * w / (w + f.polytropic_corner_speed)) / g;
 }
 
 PneumaticRotaryState PneumaticRotaryPlant::state() const {
@@ -60,15 +84,11 @@ double PneumaticRotaryPlant::spool_position(double u, double t) const {
   const auto& p = params_;
   double volts = u + p.valve_null_offset;
   if (p.dither) volts += p.dither_amplitude * std::sin(2.0 * std::numbers::pi * p.dither_frequency * t);
-  return std::clamp(p.solenoid_gain * volts, -p.spool_limit, p.spool_limit);
+  return std::clamp(p.solenoid_gain * volts + p.forms.spool_null_shift, -p.spool_limit, p.spool_limit);
 }
 
 double PneumaticRotaryPlant::port_opening(double x) const {
-  const double o = params_.valve_overlap;
-  if (!(o > 0.0)) return x;
-  if (x > o) return x - o;
-  if (x < -o) return x + o;
-  return 0.0;
+  return overlapped_spool(x, params_.valve_overlap, params_.forms.overlap_edge_radius);
 }
 
 double PneumaticRotaryPlant::end_stop_torque(double theta, double omega) const {
@@ -102,8 +122,9 @@ void PneumaticRotaryPlant::derivatives(const Vec& y, double t, RotaryLoadMode mo
   const double x = port_opening(spool_position(u, t));
   const double m_a = p.flow_gain * x - p.flow_pressure_coefficient * y[kPa];
   const double m_b = -p.flow_gain * x - p.flow_pressure_coefficient * y[kPb];
-  dy[kPa] = gas_gain_ * m_a - motion_gain_ * omega;
-  dy[kPb] = gas_gain_ * m_b + motion_gain_ * omega;
+  const double n_scale = polytropic_scale(omega);
+  dy[kPa] = n_scale * (gas_gain_ * m_a - motion_gain_ * omega);
+  dy[kPb] = n_scale * (gas_gain_ * m_b + motion_gain_ * omega);
 
   if (stuck) {
     dy[kTheta] = 0.0;
@@ -112,7 +133,7 @@ void PneumaticRotaryPlant::derivatives(const Vec& y, double t, RotaryLoadMode mo
   }
   const double friction = stick_slip_ ? slide_direction(mode) * holding_ : 0.0;
   dy[kTheta] = omega;
-  dy[kOmega] = (residual_torque(y) - friction) / p.inertia;
+  dy[kOmega] = (residual_torque(y) - friction - hidden_torque(omega)) / p.inertia;
 }
 
 void PneumaticRotaryPlant::rk4(Vec& y, double t, RotaryLoadMode mode, double u, double h) const {
@@ -142,6 +163,15 @@ void PneumaticRotaryPlant::enter_mode_at(RotaryLoadMode mode, double theta) {
 
 void PneumaticRotaryPlant::substep(double u, double h) {
   const double t0 = t_;
+  if (params_.forms.bouc_wen_level > 0.0) {
+    // The loop state is held over the RK4 stages and advanced once per
+    // sub-step (explicit, with the sub-step's speed; bounded to [-1, 1]).
+    const auto& f = params_.forms;
+    const double w = y_[kOmega], z = bouc_wen_z_;
+    const double sgn = (w * z > 0.0) ? 1.0 : -1.0;
+    const double dz = w * h / f.bouc_wen_angle * (1.0 - (0.5 * sgn + 0.5) * std::pow(std::abs(z), f.bouc_wen_exponent));
+    bouc_wen_z_ = std::clamp(z + dz, -1.0, 1.0);
+  }
   if (!stick_slip_) {
     rk4(y_, t0, mode_, u, h);
     t_ = t0 + h;

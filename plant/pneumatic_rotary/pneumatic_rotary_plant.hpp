@@ -169,6 +169,9 @@ class PneumaticRotaryPlant : public SimulatedPlant {
   Vec y_{};
   double t_ = 0.0;
   double u_ = 0.0;  // last command, for measure()'s spool
+  double bouc_wen_z_ = 0.0;  // PneumaticHiddenForms: Bouc-Wen hysteresis state [-1, 1]
+  double hidden_torque(double omega) const;  // the second forms' hysteresis and friction [N m]
+  double polytropic_scale(double omega) const;  // n(omega) / gamma
   RotaryLoadMode mode_ = RotaryLoadMode::kStuck;
   HysteresisAnchor anchor_;
 };

@@ -32,21 +32,37 @@ struct QuarterCarHiddenEffects {
   double seal_breakaway_ratio = 1.3;      // F_brk / F_c [1]
   double seal_breakaway_velocity = 0.02;  // v_brk [m/s]; v_st = v_brk sqrt(2), v_coul = v_brk / 2
   double seal_viscous = 0.0;              // f [N s/m]
+  int seal_form = 0;                      // 0 Simscape cylinder friction, 1 exponential Stribeck on a steep step
+  // LuGre bristle friction on the body bearings (the levels of
+  // BearingFrictionParams, which then stays disabled): the second physical
+  // form of bearing friction beside the Karnopp stick/slip element.
+  bool bearing_lugre = false;
+  double lugre_sigma0 = 1e5;              // bristle stiffness [N/m]: 2 mm of presliding at 200 N
+  double lugre_sigma1 = 500.0;            // bristle damping [N s/m], about 0.05 x critical with the body
+  // Extra laminar cross-port conductance beside the worn-seal orifice (the
+  // laminar-plus-turbulent leak) [m^3/(s Pa)].
+  double extra_laminar_leak = 0.0;
   // A worn piston seal: turbulent cross-port flow K sign(dp) sqrt|dp|
   // (laminar below the valve's laminar pressure), beside the nominal laminar leak.
   double worn_seal_orifice = 0.0;         // K [m^3/s/sqrt(Pa)]
   // Spool overlap: no metering until |x_s| exceeds it, a sharp dead band.
   double valve_overlap = 0.0;             // [fraction of rated spool travel]
+  double valve_overlap_edge_radius = 0.0; // [fraction] 0: sharp lands; > 0 rounded metering edges
   // Entrained air: effective bulk modulus of oil with free air, Simscape
   // isothermal-liquid mixture law (docs/rig-models.md 1.6), n = 1.
   double air_fraction = 0.0;              // alpha at atmospheric pressure [1]
+  double air_polytropic_index = 1.0;      // n of the bubbles: 1 isothermal, 1.4 adiabatic
   // Damper with different rebound and compression coefficients (piecewise
   // linear in the relative velocity). 1, 1: the nominal symmetric damper.
   double damper_compression_factor = 1.0; // v_w - v_b > 0
   double damper_rebound_factor = 1.0;     // v_w - v_b < 0
+  double damper_rebound_progression = 0.0;  // [s/m] rebound force x (1 + this |v|): a progressive valve
   // The tyre cannot pull: contact force max(0, F). 0 keeps the nominal
   // bilateral tyre; 1 is a real contact; between, that part of a pull is lost.
   double tyre_pull_loss = 0.0;
+  // Tyre damping only while the tyre touches (a tyre that leaves the plate
+  // keeps no damper), the second form of lift-off.
+  bool tyre_damping_in_contact_only = false;
 };
 
 struct QuarterCarParams {

@@ -1,5 +1,7 @@
 #include "plant/quarter_car/quarter_car_plant.hpp"
 
+#include "plant/quarter_car/hidden_effect_laws.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -75,6 +77,7 @@ QuarterCarState QuarterCarPlant::rest_state(const QuarterCarParams& p) {
 void QuarterCarPlant::reset() {
   supply_pressure_ = params_.supply_pressure;
   chamber_leak_ = {};
+  lugre_z_ = 0.0;
   set_state(rest_state(params_));
 }
 
@@ -114,36 +117,30 @@ double QuarterCarPlant::end_stop_force(double x_r, double v_r) const {
 
 double QuarterCarPlant::suspension_force(const Vec& y) const {
   const auto& p = params_;
-  const double v_rel = y[kVw] - y[kVb];
-  const double c = p.damper_damping *
-                   (v_rel >= 0.0 ? p.hidden.damper_compression_factor : p.hidden.damper_rebound_factor);
-  return p.spring_stiffness * (y[kXw] - y[kXb]) + c * v_rel;
+  return p.spring_stiffness * (y[kXw] - y[kXb]) + damper_force(p.damper_damping, p.hidden, y[kVw] - y[kVb]);
 }
 
 double QuarterCarPlant::tyre_force(const Vec& y) const {
   const auto& p = params_;
-  const double f = (p.mass_body + p.mass_wheel) * p.gravity + p.tyre_stiffness * (y[kXr] - y[kXw]) +
-                   p.tyre_damping * (y[kVr] - y[kVw]);
+  const double spring = (p.mass_body + p.mass_wheel) * p.gravity + p.tyre_stiffness * (y[kXr] - y[kXw]);
+  if (p.hidden.tyre_damping_in_contact_only && spring < 0.0) return (1.0 - p.hidden.tyre_pull_loss) * spring;
+  const double f = spring + p.tyre_damping * (y[kVr] - y[kVw]);
   return f < 0.0 ? (1.0 - p.hidden.tyre_pull_loss) * f : f;
 }
 
 double QuarterCarPlant::seal_friction(double v, double p1, double p2) const {
-  const auto& h = params_.hidden;
-  const double fc = h.seal_preload + h.seal_pressure_coefficient * std::max(0.0, p1 + p2);
-  if (fc == 0.0 && h.seal_viscous == 0.0) return 0.0;
-  const double v_st = h.seal_breakaway_velocity * std::sqrt(2.0), v_coul = h.seal_breakaway_velocity / 2.0;
-  const double fbrk = h.seal_breakaway_ratio * fc;
-  return std::sqrt(2.0 * M_E) * (fbrk - fc) * std::exp(-(v / v_st) * (v / v_st)) * v / v_st +
-         fc * std::tanh(v / v_coul) + h.seal_viscous * v;
+  return seal_friction_force(params_.hidden, v, p1, p2);
 }
 
 double QuarterCarPlant::effective_bulk_modulus(double p) const {
-  const double alpha = params_.hidden.air_fraction;
-  if (alpha <= 0.0) return params_.bulk_modulus;
-  constexpr double pa = 101325.0;  // atmospheric [Pa abs]
-  const double pabs = std::max(pa + p, 1e3);
-  const double e = params_.bulk_modulus;
-  return e * (1.0 + alpha * pa / pabs) / (1.0 + alpha * pa * e / (pabs * pabs));
+  return mixture_bulk_modulus(params_.bulk_modulus, params_.hidden.air_fraction, params_.hidden.air_polytropic_index, p);
+}
+
+LugreLevels QuarterCarPlant::lugre_levels(const Vec& y) const {
+  const auto& b = params_.bearing_friction;
+  const auto lv = levels_at(y);
+  return {lv.coulomb, lv.breakaway, b.stribeck_velocity, b.viscous, params_.hidden.lugre_sigma0,
+          params_.hidden.lugre_sigma1};
 }
 
 BearingFrictionLevels QuarterCarPlant::levels_at(const Vec& y) const {
@@ -159,10 +156,10 @@ void QuarterCarPlant::derivatives(const Vec& y, BearingMode mode, double u, Vec&
 
   dy[kXs] = (u - y[kXs]) / p.valve_time_constant;
 
-  const double overlap = p.hidden.valve_overlap;
-  const double spool = std::abs(y[kXs]) <= overlap ? 0.0 : y[kXs] - std::copysign(overlap, y[kXs]);
+  const double spool = overlapped_spool(y[kXs], p.hidden.valve_overlap, p.hidden.valve_overlap_edge_radius);
   const ValveFlows q = valve_flows(spool, y[kP1], y[kP2], p.valve_flow_gain, supply_pressure_, p.laminar_pressure);
-  double q_leak = p.leakage ? (y[kP1] - y[kP2]) / p.leakage_resistance : 0.0;
+  double q_leak = (p.leakage ? (y[kP1] - y[kP2]) / p.leakage_resistance : 0.0) +
+                  p.hidden.extra_laminar_leak * (y[kP1] - y[kP2]);
   if (p.hidden.worn_seal_orifice > 0.0) {
     q_leak += p.hidden.worn_seal_orifice * orifice_root(y[kP1] - y[kP2], p.laminar_pressure);
   }
@@ -189,7 +186,10 @@ void QuarterCarPlant::derivatives(const Vec& y, BearingMode mode, double u, Vec&
   dy[kXw] = y[kVw];
   dy[kVw] = (f_tyre - f0 - f_susp) / p.mass_wheel;
 
-  if (!p.bearing_friction.enabled) {
+  if (p.hidden.bearing_lugre) {
+    dy[kXb] = y[kVb];
+    dy[kVb] = (f_susp - lugre_force(lugre_levels(y), lugre_z_, y[kVb])) / p.mass_body;
+  } else if (!p.bearing_friction.enabled) {
     dy[kXb] = y[kVb];
     dy[kVb] = f_susp / p.mass_body;
   } else if (mode == BearingMode::kStuck) {
@@ -242,7 +242,12 @@ void QuarterCarPlant::settle_mode() {
 
 void QuarterCarPlant::substep(double u, double h) {
   if (!params_.bearing_friction.enabled) {
+    const double vb0 = y_[kVb];
     rk4(y_, mode_, u, h);
+    // The bristle state is held over the RK4 stages and advanced exactly at
+    // the step's mean body velocity (it is far stiffer than the step).
+    if (params_.hidden.bearing_lugre)
+      lugre_z_ = lugre_advance(lugre_levels(y_), lugre_z_, 0.5 * (vb0 + y_[kVb]), h);
     return;
   }
   if (mode_ == BearingMode::kStuck) {
@@ -289,6 +294,7 @@ BearingFrictionLevels QuarterCarPlant::bearing_levels() const { return levels_at
 
 double QuarterCarPlant::bearing_force() const {
   const auto& p = params_;
+  if (p.hidden.bearing_lugre) return lugre_force(lugre_levels(y_), lugre_z_, y_[kVb]);
   if (!p.bearing_friction.enabled) return 0.0;
   if (mode_ == BearingMode::kStuck) return suspension_force();
   return sliding_friction(p.bearing_friction, levels_at(y_), slide_direction(mode_), y_[kVb]);

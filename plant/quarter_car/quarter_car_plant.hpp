@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "plant/quarter_car/bearing_friction.hpp"
+#include "plant/quarter_car/hidden_effect_laws.hpp"
 #include "plant/quarter_car/quarter_car_params.hpp"
 #include "plant/simulated_plant.hpp"
 
@@ -173,6 +174,7 @@ class QuarterCarPlant : public SimulatedPlant {
   double tyre_force(const Vec& y) const;
   double seal_friction(double v_r, double p1, double p2) const;
   double effective_bulk_modulus(double p) const;
+  LugreLevels lugre_levels(const Vec& y) const;
   double end_stop_force(double x_r, double v_r) const;
 
   QuarterCarParams params_;
@@ -181,6 +183,7 @@ class QuarterCarPlant : public SimulatedPlant {
   std::vector<ChannelInfo> commands_;
   Vec y_{};
   BearingMode mode_ = BearingMode::kStuck;
+  double lugre_z_ = 0.0;  // LuGre bristle deflection [m] (QuarterCarHiddenEffects::bearing_lugre)
   double supply_pressure_ = 0.0;            // params_.supply_pressure unless a fault lowered it
   std::array<double, 2> chamber_leak_{};  // burst-pipe orifices to tank, 0 = intact
 };

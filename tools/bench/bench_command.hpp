@@ -19,6 +19,7 @@ struct BenchOptions {
   std::string config_dir = "config";  // where quarter_car.yaml and pneumatic_rotary.yaml are
   std::vector<std::string> sections;  // run only these (names as bench_section_names()); empty = all
   std::string command_line;           // as typed, for the record
+  std::string sweep_rig;              // diagnosis_sweep: only this rig ("" = all three)
 };
 
 // Section names in the order they run.

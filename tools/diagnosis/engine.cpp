@@ -1,53 +1,24 @@
+// The diagnosis as rounds (docs/diagnosis.md 4-5): calibrate the baseline
+// against its priors; in each round screen every remaining candidate with a
+// short refit, refit the best few fully, judge them (criteria.hpp) and add
+// the winner; check each kept effect again with the others in; and when
+// nothing is named but the baseline misfits beyond the noise, say so.
 #include "tools/diagnosis/engine.hpp"
 
 #include <algorithm>
-#include <array>
-#include <cstdio>
-#include <chrono>
 #include <cmath>
 #include <iomanip>
 #include <limits>
-#include <numeric>
-#include <random>
+#include <map>
 #include <sstream>
 
-#include "tools/diagnosis/fit.hpp"
+#include "tools/diagnosis/criteria.hpp"
+#include "tools/diagnosis/evidence.hpp"
+#include "tools/diagnosis/workspace.hpp"
 
 namespace rigctl::diag {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-struct Layout {
-  std::vector<ParamSpec> specs;
-  std::vector<std::size_t> offset;  // of each effect's first parameter
-  std::size_t n_base = 0;
-};
-
-Layout layout_of(const RigModel& model, const std::vector<EffectSpec>& effects) {
-  Layout l;
-  l.specs = model.baseline();
-  l.n_base = l.specs.size();
-  for (const auto& e : effects) {
-    l.offset.push_back(l.specs.size());
-    for (const auto& p : e.params) l.specs.push_back(p);
-  }
-  return l;
-}
-
-struct Scored {
-  std::vector<double> theta;
-  std::vector<double> sigma;
-  std::vector<std::vector<double>> y;
-  std::vector<double> fit;  // per output, held-out
-  double est_sse = 0.0;
-  bool rank_deficient = false;
-};
 
 std::string fmt(double v, int prec = 4) {
   std::ostringstream os;
@@ -55,450 +26,388 @@ std::string fmt(double v, int prec = 4) {
   return os.str();
 }
 
-// Share of the residual's variance explained by its mean in quantile bins of
-// the indicator (conditional statistics, docs/diagnosis.md 3).
-double binned_r2(const std::vector<double>& ind, const std::vector<double>& e, std::size_t b, std::size_t end) {
-  if (ind.size() < end || end <= b + 20) return 0.0;
-  std::vector<std::size_t> idx(end - b);
-  std::iota(idx.begin(), idx.end(), b);
-  std::sort(idx.begin(), idx.end(), [&](auto i, auto j) { return ind[i] < ind[j]; });
-  const std::size_t bins = 20, n = idx.size();
-  double mean = 0.0;
-  for (auto i : idx) mean += e[i];
-  mean /= static_cast<double>(n);
-  double tot = 0.0, expl = 0.0;
-  for (auto i : idx) tot += (e[i] - mean) * (e[i] - mean);
-  for (std::size_t k = 0; k < bins; ++k) {
-    const std::size_t lo = k * n / bins, hi = (k + 1) * n / bins;
-    if (hi <= lo) continue;
-    double m = 0.0;
-    for (std::size_t j = lo; j < hi; ++j) m += e[idx[j]];
-    m /= static_cast<double>(hi - lo);
-    expl += static_cast<double>(hi - lo) * (m - mean) * (m - mean);
+struct Candidate {
+  std::size_t effect = 0;
+  Scored s;
+  std::size_t signal = 0;
+  double gain = 0.0, se = 0.0;
+  std::string reason;  // empty: passes
+};
+
+// ------------------------------------------------------------ calibration
+
+// The baseline's MAP fit: the priors' weight is the residual variance per
+// effective sample, first of the nominal model, then of the calibrated one
+// (a model that misfits badly holds its parameters nearer nominal, so the
+// first candidate does not inherit a baseline bent out of shape).
+Scored calibrate_baseline(Workspace& w, Diagnosis& d) {
+  const Scored nominal = w.score(w.theta_null());
+  w.prior_weight = w.residual_variance(nominal);
+  const auto free = w.free_for({});
+  Scored base = w.fit(nominal.theta, free, 60, false);
+  const int first_iterations = base.iterations;
+  w.prior_weight = w.residual_variance(base);
+  base = w.fit(base.theta, free, 60, true);
+  w.say("calibrated in " + std::to_string(first_iterations) + " + " + std::to_string(base.iterations) +
+        " iterations");
+  for (std::size_t i = 0; i < w.n_base; ++i) {
+    const auto& sp = w.specs[i];
+    Calibrated c{sp.name, sp.unit, sp.init, base.theta[i], base.sigma[i], sp.prior, !base.undetermined[i], false};
+    c.moved = sp.prior > 0.0 && std::abs(c.value - c.nominal) >= 0.5 * sp.prior * std::abs(c.nominal);
+    d.calibration.push_back(c);
+    d.baseline_parameters.push_back({sp.name, sp.unit, c.value, c.sigma, c.determined});
   }
-  return tot > 0.0 ? expl / tot : 0.0;
+  return base;
+}
+
+// ------------------------------------------------------------ one round
+
+std::vector<std::vector<double>> starts_of(const Workspace& w, std::size_t e, const std::vector<double>& from) {
+  const auto& params = w.effects[e].params;
+  std::vector<double> st = from;
+  for (std::size_t j = 0; j < params.size(); ++j) st[w.offset[e] + j] = params[j].init;
+  std::vector<std::vector<double>> starts{st};
+  for (std::size_t j = 0; j < params.size(); ++j)
+    for (double v : params[j].starts) {
+      auto s2 = st;
+      s2[w.offset[e] + j] = v;
+      starts.push_back(s2);
+    }
+  return starts;
+}
+
+// Levenberg-Marquardt iterations of a screening fit. Screening only ranks
+// the candidates for the full refit (which runs to convergence): from the
+// calibrated baseline the first two or three steps take most of a real
+// effect's cost reduction. 3 instead of 5 cut the quarter car's screening
+// (nine candidates, up to 14 free parameters, per round) by about 40 %.
+constexpr int kScreeningIterations = 3;
+
+// The free parameters of a fit with these effects in: their own, and the
+// baseline parameters that can change the outputs they act on (a rig of
+// sub-models does not replay the others' parameters; RigModel::couples).
+std::vector<bool> coupled_free(const Workspace& w, const std::vector<std::size_t>& effects) {
+  std::vector<bool> free = w.free_for(effects);
+  for (std::size_t i = 0; i < w.n_base; ++i) {
+    bool any = false;
+    for (auto e : effects) any = any || w.model.couples(i, w.effects[e].cause);
+    free[i] = any;
+  }
+  return free;
+}
+
+// A full fit with these effects in, the coupled baseline parameters free;
+// the baseline parameters held keep the standard deviations (and the
+// determined flags) of `from`, the fit they were last free in.
+Scored fit_coupled(const Workspace& w, const std::vector<double>& start, const std::vector<std::size_t>& effects,
+                   int iterations, const Scored& from) {
+  const auto free = coupled_free(w, effects);
+  Scored s = w.fit(start, free, iterations, true);
+  for (std::size_t i = 0; i < w.n_base; ++i)
+    if (!free[i] && i < from.sigma.size()) {
+      s.sigma[i] = from.sigma[i];
+      s.undetermined[i] = from.undetermined[i];
+    }
+  return s;
+}
+
+// Screening: a short refit per start of the effect's grid, the baseline's
+// parameters free too (they may have bent to mimic the missing effect),
+// effects already kept held where the current fit put them. Best first.
+std::vector<Candidate> screen(const Workspace& w, const Scored& current, const std::vector<std::size_t>& active,
+                              int round) {
+  std::vector<Candidate> out;
+  for (std::size_t e = 0; e < w.effects.size(); ++e) {
+    if (w.effects[e].stub || std::find(active.begin(), active.end(), e) != active.end()) continue;
+    w.say("round " + std::to_string(round) + ": screening " + w.effects[e].cause);
+    std::vector<bool> free = coupled_free(w, {e});
+    Candidate best;
+    best.effect = e;
+    best.s.est_sse = std::numeric_limits<double>::infinity();
+    for (const auto& s : starts_of(w, e, current.theta)) {
+      auto r = w.fit(s, free, kScreeningIterations, false);
+      if (r.est_sse < best.s.est_sse) best.s = std::move(r);
+    }
+    out.push_back(std::move(best));
+  }
+  std::sort(out.begin(), out.end(), [](const Candidate& a, const Candidate& b) { return a.s.est_sse < b.s.est_sse; });
+  return out;
+}
+
+bool strength_significant(const Workspace& w, std::size_t e, const Scored& s) {
+  for (std::size_t j = 0; j < w.effects[e].params.size(); ++j) {
+    const auto& ps = w.effects[e].params[j];
+    const double val = s.theta[w.offset[e] + j], sg = s.sigma[w.offset[e] + j];
+    if (ps.strength && std::isfinite(sg) && std::abs(val - ps.null) >= 3.0 * sg) return true;
+  }
+  return false;
+}
+
+// Full refit of the best few, each judged against the current model.
+std::vector<Candidate> refit_best(const Workspace& w, std::vector<Candidate> screened, const Scored& current,
+                                  const std::vector<std::size_t>& active, int round, Diagnosis& d) {
+  std::vector<Candidate> refits;
+  const double neff = w.n_eff(current);  // every candidate of the round is compared at this one
+  for (std::size_t c = 0; c < screened.size(); ++c) {
+    ScreenedCandidate sc;
+    sc.cause = w.effects[screened[c].effect].cause;
+    sc.round = round;
+    sc.estimation_cost = screened[c].s.est_sse;
+    if (static_cast<int>(c) >= w.options.refit_top) {
+      sc.reason = "not among the best " + std::to_string(w.options.refit_top) + " in screening";
+      d.screened.push_back(sc);
+      continue;
+    }
+    Candidate r;
+    r.effect = screened[c].effect;
+    w.say("round " + std::to_string(round) + ": refitting " + sc.cause);
+    auto act = active;
+    act.push_back(r.effect);
+    // The baseline parameters the kept and the new effects couple to are
+    // free; the others stay where the calibration put them (their
+    // sub-model's outputs do not change with the candidate).
+    r.s = fit_coupled(w, screened[c].s.theta, act, 30, current);
+    w.say("  " + sc.cause + ": refitted in " + std::to_string(r.s.iterations) + " iterations");
+    r.gain = -1e9;
+    for (std::size_t o = 0; o < w.outs().size(); ++o)
+      if (r.s.fit[o] - current.fit[o] > r.gain) r.gain = r.s.fit[o] - current.fit[o], r.signal = o;
+    const auto fits = bootstrap_fits(w.outs()[r.signal].measured, {&current.y[r.signal], &r.s.y[r.signal]},
+                                     w.val_begin, w.n, 200, 777);
+    r.se = gain_standard_error(fits, 1, 0);
+    CandidateEvidence ev{r.gain, r.se, strength_significant(w, r.effect, r.s),
+                         bic(r.s.est_sse, w.parameter_count(act), neff, w.n_est_values),
+                         bic(current.est_sse, w.parameter_count(active), neff, w.n_est_values)};
+    r.reason = rejection(ev, w.options);
+    sc.refitted = true;
+    sc.gain_percent_points = r.gain;
+    sc.signal = w.outs()[r.signal].name;
+    sc.reason = r.reason.empty() ? "passes" : r.reason;
+    w.say("  " + sc.cause + ": gain " + fmt(r.gain, 3) + " pp on " + sc.signal + " (" + sc.reason + ")");
+    d.screened.push_back(sc);
+    refits.push_back(std::move(r));
+  }
+  return refits;
+}
+
+// The largest passing gain wins; one with fewer parameters wins a near tie.
+const Candidate* choose(const Workspace& w, const std::vector<Candidate>& refits) {
+  const Candidate* win = nullptr;
+  for (const auto& r : refits)
+    if (r.reason.empty() && (!win || r.gain > win->gain)) win = &r;
+  if (!win) return nullptr;
+  const double margin = std::max(0.5, 0.1 * win->gain);
+  for (const auto& r : refits)
+    if (r.reason.empty() && r.gain >= win->gain - margin &&
+        w.effects[r.effect].params.size() < w.effects[win->effect].params.size())
+      win = &r;
+  return win;
+}
+
+// Confidence: the share of block-bootstrap resamples of the held-out part
+// in which the winner has the largest gain, and at least g_min.
+double confidence(const Workspace& w, const Candidate& win, const std::vector<Candidate>& refits,
+                  const Scored& current) {
+  std::vector<const std::vector<double>*> sims{&current.y[win.signal]};
+  std::size_t wi = 0;
+  for (std::size_t r = 0; r < refits.size(); ++r) {
+    if (&refits[r] == &win) wi = r + 1;
+    sims.push_back(&refits[r].s.y[win.signal]);
+  }
+  const auto fits = bootstrap_fits(w.outs()[win.signal].measured, sims, w.val_begin, w.n, 400, 12345);
+  int wins = 0;
+  for (const auto& row : fits) {
+    std::size_t best = 1;
+    for (std::size_t s = 2; s < row.size(); ++s)
+      if (row[s] > row[best]) best = s;
+    if (best == wi && row[best] - row[0] >= w.options.min_gain) ++wins;
+  }
+  return static_cast<double>(wins) / static_cast<double>(fits.size());
+}
+
+CauseResult describe(const Workspace& w, const Candidate& win, const std::vector<Candidate>& refits,
+                     const Scored& current, Diagnosis& d) {
+  const auto& eff = w.effects[win.effect];
+  CauseResult cr;
+  cr.cause = eff.cause;
+  cr.confidence = confidence(w, win, refits, current);
+  cr.signal = w.outs()[win.signal].name;
+  cr.baseline_fit_percent = current.fit[win.signal];
+  cr.extended_fit_percent = win.s.fit[win.signal];
+  cr.gain_percent_points = win.gain;
+  for (const auto& r : refits)
+    if (&r != &win && r.gain >= w.options.min_gain && about_equal(r.gain, win.gain, w.options))
+      cr.ambiguous_with.push_back(w.effects[r.effect].cause);
+  for (std::size_t j = 0; j < eff.params.size(); ++j) {
+    const std::size_t i = w.offset[win.effect] + j;
+    cr.parameters.push_back({eff.params[j].name, eff.params[j].unit, win.s.theta[i], win.s.sigma[i],
+                             !win.s.undetermined[i]});
+  }
+  const auto ind = w.model.indicator(cr.cause);
+  const auto before = w.residual(current, win.signal);
+  const double dt = w.n > 1 ? (w.model.time().back() - w.model.time().front()) / static_cast<double>(w.n - 1) : 1.0;
+  cr.signature = signature(cr.cause, ind.name, ind.values, before, w.outs()[win.signal].measured,
+                           current.y[win.signal], dt, w.val_begin, w.n);
+  std::ostringstream ev;
+  ev << eff.description << ". Held-out fit of " << cr.signal << " " << fmt(cr.baseline_fit_percent) << " % -> "
+     << fmt(cr.extended_fit_percent) << " % (free-run replay, +-" << fmt(win.se, 2) << " pp bootstrap)";
+  for (const auto& pv : cr.parameters)
+    ev << "; " << pv.name << " = " << (pv.determined ? fmt(pv.value) + " +- " + fmt(pv.sigma, 2) : "undetermined")
+       << " " << pv.unit;
+  if (!ind.name.empty()) {
+    const double r2a = binned_r2(ind.values, before, w.val_begin, w.n);
+    const double r2b = binned_r2(ind.values, w.residual(win.s, win.signal), w.val_begin, w.n);
+    ev << "; residual of " << cr.signal << " explained by " << ind.name << " (binned): R2 " << fmt(r2a, 2)
+       << " before, " << fmt(r2b, 2) << " after";
+    d.cause_plots.push_back({cr.cause, ind.name, cr.signal, ind.values, before, w.model.effect_term(cr.cause, win.s.theta)});
+  }
+  if (!cr.signature.empty()) ev << "; signature: " << cr.signature;
+  if (!cr.ambiguous_with.empty()) {
+    ev << "; about as well explained by";
+    for (const auto& a : cr.ambiguous_with) ev << " " << a;
+  }
+  ev << "; beat the other refitted candidates in " << fmt(100.0 * cr.confidence, 3)
+     << " % of block-bootstrap resamples of the held-out part";
+  cr.evidence = ev.str();
+  return cr;
+}
+
+// ------------------------------------------------------------ after the rounds
+
+// Every kept effect must still earn g_min with the others in.
+void backward_check(const Workspace& w, std::vector<std::size_t>& active, Scored& current, Diagnosis& d) {
+  if (active.size() < 2) return;
+  for (std::size_t k = 0; k < active.size();) {
+    std::vector<std::size_t> others;
+    for (std::size_t j = 0; j < active.size(); ++j)
+      if (j != k) others.push_back(active[j]);
+    auto start = current.theta;
+    const auto& eff = w.effects[active[k]];
+    for (std::size_t j = 0; j < eff.params.size(); ++j) start[w.offset[active[k]] + j] = eff.params[j].null;
+    w.say("backward check: without " + eff.cause);
+    const Scored without = fit_coupled(w, start, others, 60, current);
+    double best = -1e9;
+    for (std::size_t o = 0; o < w.outs().size(); ++o) best = std::max(best, current.fit[o] - without.fit[o]);
+    if (best < w.options.min_gain) {
+      w.say("  dropped " + eff.cause + " (only " + fmt(best, 3) + " pp given the others)");
+      d.causes.erase(std::remove_if(d.causes.begin(), d.causes.end(), [&](auto& r) { return r.cause == eff.cause; }),
+                     d.causes.end());
+      active.erase(active.begin() + static_cast<std::ptrdiff_t>(k));
+      current = without;
+    } else {
+      ++k;
+    }
+  }
+}
+
+// No cause, but a channel whose held-out residual is four times its noise
+// floor or more (and its fit below 99.5 %, so a channel measured far more
+// finely than it moves does not count): the model is wrong in a way nobody
+// named.
+void check_unexplained(const Workspace& w, const Scored& current, Diagnosis& d) {
+  if (!d.causes.empty()) return;
+  const double dt = w.n > 1 ? (w.model.time().back() - w.model.time().front()) / static_cast<double>(w.n - 1) : 1.0;
+  double worst = 0.0;
+  for (std::size_t o = 0; o < w.outs().size(); ++o) {
+    const auto e = w.residual(current, o);
+    double ss = 0.0;
+    for (std::size_t i = w.val_begin; i < w.n; ++i) ss += e[i] * e[i];
+    const double rms = std::sqrt(ss / static_cast<double>(std::max<std::size_t>(1, w.n - w.val_begin)));
+    const double noise = noise_floor(w.outs()[o].measured);
+    const double excess = noise > 0.0 ? rms / noise : 0.0;
+    if (current.fit[o] < 99.5 && excess > 4.0 && excess > worst) {
+      worst = excess;
+      const Band band = power_band(e, dt, w.val_begin, w.n);
+      d.unexplained = true;
+      d.unexplained_residual = {w.outs()[o].name, rms, noise, band.lo_hz, band.hi_hz, band.peak_hz};
+    }
+  }
+  if (d.unexplained)
+    w.say("unexplained: " + d.unexplained_residual.signal + " misfits " + fmt(worst, 3) + " x its noise floor, " +
+          fmt(d.unexplained_residual.band_lo_hz, 3) + "-" + fmt(d.unexplained_residual.band_hi_hz, 3) + " Hz");
+}
+
+void finish(const Workspace& w, const std::vector<std::size_t>& active, const Scored& base, const Scored& current,
+            Diagnosis& d) {
+  d.cause = d.causes.empty() ? "none" : d.causes.front().cause;
+  const auto fr = w.free_for(active);
+  for (std::size_t i = 0; i < w.specs.size(); ++i)
+    if (fr[i])
+      d.final_parameters.push_back({w.specs[i].name, w.specs[i].unit, current.theta[i],
+                                    current.sigma.empty() ? 0.0 : current.sigma[i],
+                                    current.undetermined.empty() || !current.undetermined[i]});
+  // Each named cause reports its parameters from the final joint fit: the
+  // round that accepted it ran without the effects added later.
+  for (auto& cr : d.causes)
+    for (auto e : active)
+      if (w.effects[e].cause == cr.cause)
+        for (std::size_t j = 0; j < cr.parameters.size(); ++j) {
+          const std::size_t i = w.offset[e] + j;
+          cr.parameters[j].value = current.theta[i];
+          if (!current.sigma.empty()) cr.parameters[j].sigma = current.sigma[i];
+          if (!current.undetermined.empty()) cr.parameters[j].determined = !current.undetermined[i];
+        }
+  for (std::size_t o = 0; o < w.outs().size(); ++o) {
+    d.baseline_fit_percent[w.outs()[o].name] = base.fit[o];
+    d.extended_fit_percent[w.outs()[o].name] = current.fit[o];
+  }
+  std::size_t moved = 0;
+  for (const auto& c : d.calibration) moved += c.moved ? 1 : 0;
+  std::ostringstream v;
+  v << "contiguous split: the first " << fmt(100.0 * (1.0 - w.options.holdout_fraction), 3) << " % of the record ("
+    << w.n_est << " of " << w.n << " samples, after a " << w.init
+    << "-sample initialisation window) for fitting, the last " << fmt(100.0 * w.options.holdout_fraction, 3)
+    << " % held out; fits above are free-run simulations of the whole record with the fitted parameters, scored "
+       "on the held-out samples only; the baseline is calibrated first (its uncertain parameters free, each "
+       "regularised toward nominal by a prior of its stated tolerance; "
+    << moved << " moved by half their tolerance or more); " << w.model.replay();
+  d.validation = v.str();
+  d.t = w.model.time();
+  d.validation_start = w.val_begin;
+  for (std::size_t o = 0; o < w.outs().size(); ++o) {
+    d.output_names.push_back(w.outs()[o].name);
+    d.measured.push_back(w.outs()[o].measured);
+    d.y_baseline.push_back(base.y[o]);
+    d.y_extended.push_back(current.y[o]);
+  }
 }
 
 }  // namespace
 
-double fit_percent(const std::vector<double>& y, const std::vector<double>& y_sim, std::size_t begin, std::size_t end) {
-  end = std::min({end, y.size(), y_sim.size()});
-  if (end <= begin) return 0.0;
-  double mean = 0.0;
-  for (std::size_t i = begin; i < end; ++i) mean += y[i];
-  mean /= static_cast<double>(end - begin);
-  double num = 0.0, den = 0.0;
-  for (std::size_t i = begin; i < end; ++i) {
-    num += (y[i] - y_sim[i]) * (y[i] - y_sim[i]);
-    den += (y[i] - mean) * (y[i] - mean);
-  }
-  if (den <= 0.0) return 0.0;
-  return 100.0 * (1.0 - std::sqrt(num / den));
-}
-
 Diagnosis diagnose(const RigModel& model, const DiagnoseOptions& opt) {
-  const auto t0 = Clock::now();
-  auto say = [&](const std::string& s) {
-    if (opt.progress) *opt.progress << "diagnose [" << std::fixed << std::setprecision(1) << seconds_since(t0)
-                                    << std::defaultfloat << " s] " << s << std::endl;
-  };
+  const auto t0 = std::chrono::steady_clock::now();
+  Workspace w(model, opt);
   Diagnosis d;
   d.rig = to_string(model.rig());
-  const auto effects = model.effects();
-  const Layout L = layout_of(model, effects);
-  const auto& outs = model.outputs();
-  const std::size_t n = model.time().size();
-  const std::size_t init = std::min(model.init_window(), n / 10);
-  const std::size_t n_est = static_cast<std::size_t>(std::floor(static_cast<double>(n) * (1.0 - opt.holdout_fraction)));
-  const std::size_t val_begin = std::max(n_est, init);
-  std::vector<unsigned char> est_mask(n, 0);
-  for (std::size_t i = init; i < n_est; ++i) est_mask[i] = 1;
-  std::vector<double> weight;
-  for (const auto& o : outs) {
-    double m = 0.0, s = 0.0;
-    for (double v : o.measured) m += v;
-    m /= static_cast<double>(n);
-    for (double v : o.measured) s += (v - m) * (v - m);
-    s = std::sqrt(s / static_cast<double>(n));
-    weight.push_back(s > 0.0 ? 1.0 / s : 1.0);
-  }
-  for (const auto& e : effects)
+  for (const auto& e : w.effects)
     if (e.stub) d.stubs.push_back(e.cause);
 
-  std::vector<double> theta_null(L.specs.size());
-  for (std::size_t i = 0; i < L.specs.size(); ++i) theta_null[i] = i < L.n_base ? L.specs[i].init : L.specs[i].null;
-
-  auto score = [&](const std::vector<double>& theta) {
-    Scored s;
-    s.theta = theta;
-    model.simulate(theta, s.y);
-    for (std::size_t o = 0; o < outs.size(); ++o) s.fit.push_back(fit_percent(outs[o].measured, s.y[o], val_begin, n));
-    return s;
-  };
-  auto fit = [&](const std::vector<double>& start, const std::vector<bool>& free, int iters, bool cov) {
-    FitProblem p;
-    p.model = &model;
-    p.specs = L.specs;
-    p.free = free;
-    p.theta0 = start;
-    p.mask = est_mask;
-    p.weight = weight;
-    p.max_iterations = iters;
-    const auto r = fit_output_error(p, cov);
-    Scored s = score(r.theta);
-    s.sigma = r.sigma;
-    s.est_sse = 2.0 * r.cost;
-    s.rank_deficient = r.rank_deficient;
-    return s;
-  };
-  auto free_for = [&](const std::vector<std::size_t>& active) {
-    std::vector<bool> f(L.specs.size(), false);
-    for (std::size_t i = 0; i < L.n_base; ++i) f[i] = true;
-    for (auto e : active)
-      for (std::size_t j = 0; j < effects[e].params.size(); ++j) f[L.offset[e] + j] = true;
-    return f;
-  };
-  std::size_t n_free_est = 0;
-  for (auto m : est_mask) n_free_est += m;
-  n_free_est *= outs.size();
-  auto residual_of = [&](const Scored& s, std::size_t o) {
-    std::vector<double> r(n);
-    for (std::size_t i = 0; i < n; ++i) r[i] = outs[o].measured[i] - s.y[o][i];
-    return r;
-  };
-  // N_eff of a model's residual (its colour); two models are compared with
-  // the same N_eff (the current model's), or a candidate whose residual is
-  // more coloured would be judged on fewer samples and lose for that alone.
-  auto n_eff = [&](const Scored& s) {
-    std::vector<double> r;
-    const auto e = residual_of(s, 0);
-    for (std::size_t i = 0; i < n; ++i)
-      if (est_mask[i]) r.push_back(e[i] * weight[0]);
-    return std::max(10.0, static_cast<double>(n_free_est) * effective_fraction(r));
-  };
-  auto bic = [&](const Scored& s, std::size_t k, double neff) {
-    return neff * std::log(std::max(s.est_sse, 1e-300) / static_cast<double>(n_free_est)) +
-           static_cast<double>(k) * std::log(neff);
-  };
-
-  say("baseline fit (" + std::to_string(L.n_base) + " parameters, " + std::to_string(n) + " samples)");
-  Scored current = fit(theta_null, free_for({}), 100, true);
-  const Scored base = current;
-  for (std::size_t i = 0; i < L.n_base; ++i)
-    d.baseline_parameters.push_back({L.specs[i].name, L.specs[i].unit, base.theta[i], base.sigma[i]});
+  w.say("baseline calibration (" + std::to_string(w.n_base) + " parameters, " + std::to_string(w.n) + " samples)");
+  const Scored base = calibrate_baseline(w, d);
   {
     std::string s = "baseline held-out fit:";
-    for (std::size_t o = 0; o < outs.size(); ++o) s += " " + outs[o].name + " " + fmt(base.fit[o]) + " %";
-    say(s);
+    for (std::size_t o = 0; o < w.outs().size(); ++o) s += " " + w.outs()[o].name + " " + fmt(base.fit[o]) + " %";
+    w.say(s);
   }
+  Scored current = base;
   std::vector<std::size_t> active;
-  std::vector<bool> tried(effects.size(), false);
-  for (std::size_t e = 0; e < effects.size(); ++e) tried[e] = effects[e].stub;
-
   for (int round = 1; round <= opt.max_effects; ++round) {
-    // Screening: short refits from each start of the effect's grid.
-    struct Cand {
-      std::size_t e;
-      Scored s;
-    };
-    std::vector<Cand> cands;
-    for (std::size_t e = 0; e < effects.size(); ++e) {
-      if (tried[e] || std::find(active.begin(), active.end(), e) != active.end()) continue;
-      say("round " + std::to_string(round) + ": screening " + effects[e].cause);
-      // Screening frees the candidate's parameters and the baseline's (the
-      // baseline fit has bent its parameters to mimic the missing effect, so
-      // they must be able to move back); effects already kept stay where the
-      // current fit put them. The best few are then refitted with all free.
-      std::vector<bool> free = free_for({});
-      for (std::size_t j = 0; j < effects[e].params.size(); ++j) free[L.offset[e] + j] = true;
-      std::vector<std::vector<double>> starts;
-      std::vector<double> st = current.theta;
-      for (std::size_t j = 0; j < effects[e].params.size(); ++j) st[L.offset[e] + j] = effects[e].params[j].init;
-      starts.push_back(st);
-      for (std::size_t j = 0; j < effects[e].params.size(); ++j)
-        for (double v : effects[e].params[j].starts) {
-          auto s2 = st;
-          s2[L.offset[e] + j] = v;
-          starts.push_back(s2);
-        }
-      Scored best;
-      best.est_sse = std::numeric_limits<double>::infinity();
-      for (const auto& s : starts) {
-        auto r = fit(s, free, 5, false);
-        if (r.est_sse < best.est_sse) best = std::move(r);
-      }
-      cands.push_back({e, std::move(best)});
-    }
-    if (cands.empty()) break;
-    std::sort(cands.begin(), cands.end(), [](const Cand& a, const Cand& b) { return a.s.est_sse < b.s.est_sse; });
-    struct Refit {
-      std::size_t e;
-      Scored s;
-      std::size_t signal;
-      double gain;
-      std::string reason;
-      bool pass;
-      double se;
-    };
-    std::vector<Refit> refits;
-    const double neff = n_eff(current);  // every candidate of the round is compared at this one
-    for (std::size_t c = 0; c < cands.size(); ++c) {
-      ScreenedCandidate sc;
-      sc.cause = effects[cands[c].e].cause;
-      sc.round = round;
-      sc.estimation_cost = cands[c].s.est_sse;
-      if (static_cast<int>(c) >= opt.refit_top) {
-        sc.reason = "not among the best " + std::to_string(opt.refit_top) + " in screening";
-        d.screened.push_back(sc);
-        continue;
-      }
-      const std::size_t e = cands[c].e;
-      say("round " + std::to_string(round) + ": refitting " + effects[e].cause);
-      auto act = active;
-      act.push_back(e);
-      Scored s = fit(cands[c].s.theta, free_for(act), 30, true);
-      std::size_t sig = 0;
-      double gain = -1e9;
-      for (std::size_t o = 0; o < outs.size(); ++o)
-        if (s.fit[o] - current.fit[o] > gain) {
-          gain = s.fit[o] - current.fit[o];
-          sig = o;
-        }
-      // Standard error of the gain: block bootstrap over 10 held-out sub-blocks,
-      // each resample scored as a whole (a sub-block alone can have too little
-      // variance for a meaningful fit percent).
-      const double se = [&] {
-        const std::size_t nb = 10;
-        std::vector<std::array<double, 4>> st(nb);  // e_cur^2, e_new^2, y, y^2
-        for (std::size_t k = 0; k < nb; ++k) {
-          const std::size_t b0 = val_begin + (n - val_begin) * k / nb, e0 = val_begin + (n - val_begin) * (k + 1) / nb;
-          std::array<double, 4> a{0, 0, 0, 0};
-          for (std::size_t i = b0; i < e0; ++i) {
-            const double y = outs[sig].measured[i];
-            a[0] += (y - current.y[sig][i]) * (y - current.y[sig][i]);
-            a[1] += (y - s.y[sig][i]) * (y - s.y[sig][i]);
-            a[2] += y;
-            a[3] += y * y;
-          }
-          st[k] = a;
-        }
-        std::mt19937 rng(777);
-        std::uniform_int_distribution<std::size_t> pick(0, nb - 1);
-        const double cnt = static_cast<double>(n - val_begin);
-        double sy = 0.0, sy2 = 0.0;
-        for (const auto& q : st) sy += q[2], sy2 += q[3];
-        const double var_all = sy2 - sy * sy / cnt;
-        double m1 = 0.0, m2 = 0.0;
-        const int B = 200;
-        for (int r = 0; r < B; ++r) {
-          std::array<double, 4> a{0, 0, 0, 0};
-          for (std::size_t k = 0; k < nb; ++k) {
-            const auto& q = st[pick(rng)];
-            for (int j = 0; j < 4; ++j) a[static_cast<std::size_t>(j)] += q[static_cast<std::size_t>(j)];
-          }
-          const double var = var_all;  // fixed denominator: the held-out variance
-          const double g = var > 0 ? 100.0 * (std::sqrt(a[0] / var) - std::sqrt(a[1] / var)) : 0.0;
-          m1 += g;
-          m2 += g * g;
-        }
-        m1 /= B;
-        return std::sqrt(std::max(0.0, m2 / B - m1 * m1));
-      }();
-      std::string reason;
-      const double need = std::max(opt.min_gain, 2.0 * se);
-      if (!(gain >= need)) reason = "held-out gain " + fmt(gain, 3) + " pp below " + fmt(need, 3) + " pp";
-      bool significant = false;
-      for (std::size_t j = 0; j < effects[e].params.size(); ++j) {
-        const auto& ps = effects[e].params[j];
-        if (!ps.strength) continue;
-        const double val = s.theta[L.offset[e] + j], sg = s.sigma[L.offset[e] + j];
-        if (std::isfinite(sg) && std::abs(val - ps.null) >= 3.0 * sg) significant = true;
-      }
-      if (reason.empty() && !significant) reason = "effect strength not significant (< 3 sigma)";
-      std::size_t k_cur = L.n_base, k_new = L.n_base + effects[e].params.size();
-      for (auto a : active) k_cur += effects[a].params.size(), k_new += effects[a].params.size();
-      if (reason.empty() && !(bic(s, k_new, neff) < bic(current, k_cur, neff))) reason = "BIC (with N_eff) not lower";
-      sc.refitted = true;
-      sc.gain_percent_points = gain;
-      sc.signal = outs[sig].name;
-      sc.reason = reason.empty() ? "passes" : reason;
-      say("  " + effects[e].cause + ": gain " + fmt(gain, 3) + " pp on " + outs[sig].name + " (" + sc.reason + ")");
-      d.screened.push_back(sc);
-      refits.push_back({e, std::move(s), sig, gain, reason, reason.empty(), se});
-    }
-    const Refit* winner = nullptr;
-    for (const auto& r : refits)
-      if (r.pass && (!winner || r.gain > winner->gain)) winner = &r;
-    if (!winner) break;
-    // Parsimony among the passing: a candidate with fewer parameters whose gain
-    // is within 10 % of the winner's (at least 0.5 pp) wins the tie.
-    {
-      const double margin = std::max(0.5, 0.1 * winner->gain);
-      for (const auto& r : refits)
-        if (r.pass && r.gain >= winner->gain - margin &&
-            effects[r.e].params.size() < effects[winner->e].params.size())
-          winner = &r;
-    }
+    auto screened = screen(w, current, active, round);
+    if (screened.empty()) break;
+    const auto refits = refit_best(w, std::move(screened), current, active, round, d);
+    const Candidate* win = choose(w, refits);
+    if (!win) break;
     for (auto& sc : d.screened)
-      if (sc.round == round && sc.cause == effects[winner->e].cause) sc.accepted = true;
-
-    // Confidence: block bootstrap over 10 held-out sub-blocks; the share of
-    // resamples in which the winner has the largest gain and at least g_min.
-    const std::size_t sig = winner->signal;
-    const std::size_t nb = 10;
-    auto block_stats = [&](const std::vector<double>& ysim) {
-      std::vector<std::array<double, 3>> st(nb);  // sum e^2, sum y, sum y^2
-      for (std::size_t k = 0; k < nb; ++k) {
-        const std::size_t b = val_begin + (n - val_begin) * k / nb, en = val_begin + (n - val_begin) * (k + 1) / nb;
-        std::array<double, 3> a{0, 0, 0};
-        for (std::size_t i = b; i < en; ++i) {
-          const double y = outs[sig].measured[i];
-          a[0] += (y - ysim[i]) * (y - ysim[i]);
-          a[1] += y;
-          a[2] += y * y;
-        }
-        st[k] = a;
-      }
-      return st;
-    };
-    auto cur_st = block_stats(current.y[sig]);
-    std::vector<std::vector<std::array<double, 3>>> cand_st;
-    for (const auto& r : refits) cand_st.push_back(block_stats(r.s.y[sig]));
-    std::mt19937 rng(12345);
-    std::uniform_int_distribution<std::size_t> pick(0, nb - 1);
-    int wins = 0;
-    const int B = 400;
-    const std::size_t per_block = (n - val_begin) / nb;
-    for (int bsi = 0; bsi < B; ++bsi) {
-      std::vector<std::size_t> sel(nb);
-      for (auto& s : sel) s = pick(rng);
-      auto fitp = [&](const std::vector<std::array<double, 3>>& st) {
-        double e2 = 0, sy = 0, sy2 = 0;
-        for (auto s : sel) e2 += st[s][0], sy += st[s][1], sy2 += st[s][2];
-        const double cnt = static_cast<double>(per_block * nb);
-        const double var = sy2 - sy * sy / cnt;
-        return var > 0 ? 100.0 * (1.0 - std::sqrt(e2 / var)) : 0.0;
-      };
-      const double fc = fitp(cur_st);
-      double best_gain = -1e9;
-      std::size_t best_i = 0;
-      for (std::size_t r = 0; r < refits.size(); ++r) {
-        const double g = fitp(cand_st[r]) - fc;
-        if (g > best_gain) best_gain = g, best_i = r;
-      }
-      if (&refits[best_i] == winner && best_gain >= opt.min_gain) ++wins;
-    }
-
-    const std::size_t e = winner->e;
-    CauseResult cr;
-    cr.cause = effects[e].cause;
-    cr.confidence = static_cast<double>(wins) / B;
-    cr.signal = outs[sig].name;
-    cr.baseline_fit_percent = current.fit[sig];
-    cr.extended_fit_percent = winner->s.fit[sig];
-    cr.gain_percent_points = winner->gain;
-    for (std::size_t j = 0; j < effects[e].params.size(); ++j) {
-      const auto& ps = effects[e].params[j];
-      cr.parameters.push_back({ps.name, ps.unit, winner->s.theta[L.offset[e] + j], winner->s.sigma[L.offset[e] + j]});
-    }
-    // Evidence: the refit numbers and the conditional statistics of the
-    // residual before the effect on its indicator.
-    const auto ind = model.indicator(cr.cause);
-    const auto res_before = residual_of(current, sig);
-    std::ostringstream ev;
-    ev << effects[e].description << ". Held-out fit of " << cr.signal << " " << fmt(cr.baseline_fit_percent) << " % -> "
-       << fmt(cr.extended_fit_percent) << " % (free-run replay)";
-    for (const auto& pv : cr.parameters)
-      ev << "; " << pv.name << " = " << fmt(pv.value) << " +- " << fmt(pv.sigma, 2) << " " << pv.unit;
-    if (!ind.name.empty()) {
-      const double r2a = binned_r2(ind.values, res_before, val_begin, n);
-      const auto res_after = residual_of(winner->s, sig);
-      const double r2b = binned_r2(ind.values, res_after, val_begin, n);
-      ev << "; residual of " << cr.signal << " explained by " << ind.name << " (binned): R2 " << fmt(r2a, 2)
-         << " before, " << fmt(r2b, 2) << " after";
-      Diagnosis::CausePlot cp;
-      cp.cause = cr.cause;
-      cp.indicator_name = ind.name;
-      cp.signal = cr.signal;
-      cp.indicator = ind.values;
-      cp.residual = res_before;
-      cp.effect_term = model.effect_term(cr.cause, winner->s.theta);
-      d.cause_plots.push_back(std::move(cp));
-    }
-    ev << "; beat the other refitted candidates in " << fmt(100.0 * cr.confidence, 3)
-       << " % of block-bootstrap resamples of the held-out part";
-    cr.evidence = ev.str();
-    say("accepted " + cr.cause + " (gain " + fmt(cr.gain_percent_points, 3) + " pp on " + cr.signal + ")");
-    d.causes.push_back(cr);
-    active.push_back(e);
-    current = winner->s;
-    // a rejected candidate stays in the pool: with another effect in, it may earn its place
+      if (sc.round == round && sc.cause == w.effects[win->effect].cause) sc.accepted = true;
+    d.causes.push_back(describe(w, *win, refits, current, d));
+    w.say("accepted " + d.causes.back().cause + " (gain " + fmt(win->gain, 3) + " pp on " + d.causes.back().signal + ")");
+    active.push_back(win->effect);
+    current = win->s;  // a rejected candidate stays in the pool: with another effect in, it may pass
   }
-
-  // Backward check: every kept effect must still earn its place given the others.
-  if (active.size() > 1) {
-    for (std::size_t k = 0; k < active.size();) {
-      std::vector<std::size_t> others;
-      for (std::size_t j = 0; j < active.size(); ++j)
-        if (j != k) others.push_back(active[j]);
-      auto start = current.theta;
-      for (std::size_t j = 0; j < effects[active[k]].params.size(); ++j)
-        start[L.offset[active[k]] + j] = effects[active[k]].params[j].null;
-      say("backward check: without " + effects[active[k]].cause);
-      const Scored without = fit(start, free_for(others), 60, false);
-      double best = -1e9;
-      for (std::size_t o = 0; o < outs.size(); ++o) best = std::max(best, current.fit[o] - without.fit[o]);
-      if (best < opt.min_gain) {
-        say("  dropped " + effects[active[k]].cause + " (only " + fmt(best, 3) + " pp given the others)");
-        const std::string c = effects[active[k]].cause;
-        d.causes.erase(std::remove_if(d.causes.begin(), d.causes.end(), [&](auto& r) { return r.cause == c; }),
-                       d.causes.end());
-        active.erase(active.begin() + static_cast<std::ptrdiff_t>(k));
-        current = without;
-      } else {
-        ++k;
-      }
-    }
-  }
-
-  d.cause = d.causes.empty() ? "none" : d.causes.front().cause;
-  {
-    const auto fr = free_for(active);
-    for (std::size_t i = 0; i < L.specs.size(); ++i)
-      if (fr[i]) d.final_parameters.push_back({L.specs[i].name, L.specs[i].unit, current.theta[i], current.sigma.empty() ? 0.0 : current.sigma[i]});
-    // Each named cause reports its parameters from the final joint fit: the
-    // values of the round that accepted it were fitted without the effects
-    // added later, which may have carried part of its work.
-    for (auto& cr : d.causes)
-      for (auto e : active)
-        if (effects[e].cause == cr.cause)
-          for (std::size_t j = 0; j < cr.parameters.size() && j < effects[e].params.size(); ++j) {
-            cr.parameters[j].value = current.theta[L.offset[e] + j];
-            if (!current.sigma.empty()) cr.parameters[j].sigma = current.sigma[L.offset[e] + j];
-          }
-  }
-  for (std::size_t o = 0; o < outs.size(); ++o) {
-    d.baseline_fit_percent[outs[o].name] = base.fit[o];
-    d.extended_fit_percent[outs[o].name] = current.fit[o];
-  }
-  std::ostringstream v;
-  v << "contiguous split: the first " << fmt(100.0 * (1.0 - opt.holdout_fraction), 3) << " % of the record ("
-    << n_est << " of " << n << " samples, after a " << init
-    << "-sample initialisation window) for fitting, the last " << fmt(100.0 * opt.holdout_fraction, 3)
-    << " % held out; fits above are free-run simulations of the whole record with the fitted parameters, scored "
-       "on the held-out samples only; "
-    << model.replay();
-  d.validation = v.str();
-  d.t = model.time();
-  d.validation_start = val_begin;
-  for (std::size_t o = 0; o < outs.size(); ++o) {
-    d.output_names.push_back(outs[o].name);
-    d.measured.push_back(outs[o].measured);
-    d.y_baseline.push_back(base.y[o]);
-    d.y_extended.push_back(current.y[o]);
-  }
-  d.elapsed_s = seconds_since(t0);
-  say("done: cause " + d.cause);
+  backward_check(w, active, current, d);
+  check_unexplained(w, current, d);
+  finish(w, active, base, current, d);
+  d.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  w.say("done: cause " + d.cause);
   return d;
 }
 

@@ -21,6 +21,17 @@ struct ParamValue {
   std::string unit;
   double value = 0.0;
   double sigma = 0.0;
+  bool determined = true;  // false: the run cannot determine it; the JSON writes null and lists it as undetermined
+};
+
+// A baseline parameter after the calibration: where it started (the
+// nominal), where the fit put it, and whether the run moved it.
+struct Calibrated {
+  std::string name, unit;
+  double nominal = 0.0, value = 0.0, sigma = 0.0;
+  double tolerance = 0.0;  // the prior's relative standard deviation (0: no prior)
+  bool determined = true;
+  bool moved = false;      // by at least half its tolerance
 };
 
 struct CauseResult {
@@ -32,6 +43,8 @@ struct CauseResult {
   double extended_fit_percent = 0.0;  // ... and with it
   double gain_percent_points = 0.0;
   std::string signal;
+  std::vector<std::string> ambiguous_with;  // candidates that explained the residual about as well
+  std::string signature;                    // what the residual shows of the effect's signature
 };
 
 struct ScreenedCandidate {
@@ -55,6 +68,16 @@ struct Diagnosis {
   std::vector<ScreenedCandidate> screened;
   std::vector<ParamValue> baseline_parameters;
   std::vector<ParamValue> final_parameters;  // baseline + kept effects, refitted jointly
+  std::vector<Calibrated> calibration;       // the baseline's calibration against its priors
+  // The baseline misfits beyond the noise but no candidate earned a validated
+  // gain: cause stays none, and the residual is described.
+  bool unexplained = false;
+  struct Residual {
+    std::string signal;
+    double rms = 0.0, noise = 0.0;         // held-out residual and the noise floor estimated from the record
+    double band_lo_hz = 0.0, band_hi_hz = 0.0, peak_hz = 0.0;  // 10-90 % of its power, and its peak
+  };
+  Residual unexplained_residual;
   std::vector<std::string> stubs;  // cause ids whose candidate is not implemented yet
   double elapsed_s = 0.0;
 
@@ -73,6 +96,13 @@ struct Diagnosis {
 struct DiagnoseOptions {
   double holdout_fraction = 0.2;  // last contiguous block held out
   double min_gain = 1.0;          // g_min [percentage points]
+  // A held-out gain this large (and at least strong_se standard errors) is
+  // evidence on its own: the parameter-significance test cannot veto it.
+  double strong_gain = 3.0;
+  double strong_se = 4.0;
+  // Two candidates explain the residual about equally when their gains
+  // differ by less than this (and a tenth of the larger).
+  double ambiguity_margin = 0.5;
   int refit_top = 3;              // K
   int max_effects = 3;
   std::ostream* progress = nullptr;  // stderr in the program

@@ -18,6 +18,7 @@ namespace {
 struct Residuals {
   const FitProblem* p;
   std::vector<int> free_index;
+  std::vector<int> prior_index;  // free parameters with a prior (one residual each, after the data)
   std::size_t count = 0;
 
   void theta_from(const double* z, std::vector<double>& theta) const {
@@ -42,6 +43,11 @@ struct Residuals {
         const double e = (y[o][i] - m[i]) * p->weight[o];
         r[k++] = std::isfinite(e) ? std::clamp(e, -1e6, 1e6) : 1e6;
       }
+    }
+    const double w = std::sqrt(std::max(0.0, p->prior_weight));
+    for (int i : prior_index) {
+      const auto& sp = p->specs[static_cast<std::size_t>(i)];
+      r[k++] = w * (theta[static_cast<std::size_t>(i)] - sp.init) / (sp.prior * std::abs(sp.init));
     }
   }
 };
@@ -136,14 +142,19 @@ FitResult fit_output_error(const FitProblem& p, bool with_covariance) {
   auto* res = new Residuals;
   res->p = &p;
   for (std::size_t i = 0; i < p.specs.size(); ++i)
-    if (p.free[i]) res->free_index.push_back(static_cast<int>(i));
+    if (p.free[i]) {
+      res->free_index.push_back(static_cast<int>(i));
+      if (p.specs[i].prior > 0.0 && p.specs[i].init != 0.0 && p.prior_weight > 0.0)
+        res->prior_index.push_back(static_cast<int>(i));
+    }
   std::size_t masked = 0;
   for (auto m : p.mask) masked += m ? 1 : 0;
-  res->count = masked * p.model->outputs().size();
+  res->count = masked * p.model->outputs().size() + res->prior_index.size();
 
   FitResult out;
   out.theta = p.theta0;
   out.sigma.assign(p.specs.size(), 0.0);
+  out.undetermined.assign(p.specs.size(), false);
   const std::size_t nf = res->free_index.size();
   std::unique_ptr<Residuals> owner(res);
   if (nf == 0) {
@@ -200,8 +211,16 @@ FitResult fit_output_error(const FitProblem& p, bool with_covariance) {
   const auto& m0 = p.model->outputs()[0].measured;
   for (std::size_t i = 0; i < m0.size(); ++i)
     if (p.mask[i]) r.push_back((y[0][i] - m0[i]) * p.weight[0]);
-  const double dof = std::max(1.0, static_cast<double>(count) - static_cast<double>(nf));
-  const double s2 = 2.0 * out.cost / dof / effective_fraction(r);
+  double data_sse = 0.0;
+  for (std::size_t o = 0; o < p.model->outputs().size(); ++o)
+    for (std::size_t i = 0; i < m0.size(); ++i)
+      if (p.mask[i]) {
+        const double e = (y[o][i] - p.model->outputs()[o].measured[i]) * p.weight[o];
+        if (std::isfinite(e)) data_sse += e * e;
+      }
+  const double n_data = static_cast<double>(count - res->prior_index.size());
+  const double dof = std::max(1.0, n_data - static_cast<double>(nf));
+  const double s2 = data_sse / dof / effective_fraction(r);
 
   // Covariance from the Jacobian at the optimum: (J^T J)^-1 by eigen-decomposition;
   // directions with eigenvalues below 1e-10 of the largest are not identifiable.
@@ -231,6 +250,18 @@ FitResult fit_output_error(const FitProblem& p, bool with_covariance) {
     out.sigma[i] = weak ? std::numeric_limits<double>::infinity()
                         : std::sqrt(std::max(0.0, C(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(j)) * s2)) *
                               p.specs[i].scale;
+    // With a prior the posterior is always finite: the run did not determine
+    // the parameter when it is hardly narrower than the prior. The prior rows
+    // carry prior_weight, not s2, so the prior's own width is rescaled.
+    const auto& sp = p.specs[i];
+    const bool has_prior = std::find(res->prior_index.begin(), res->prior_index.end(), static_cast<int>(i)) !=
+                           res->prior_index.end();
+    if (has_prior) {
+      const double prior_sd = sp.prior * std::abs(sp.init) * std::sqrt(s2 / p.prior_weight);
+      out.undetermined[i] = !(out.sigma[i] < 0.7 * prior_sd);
+    } else {
+      out.undetermined[i] = !std::isfinite(out.sigma[i]);
+    }
   }
   return out;
 }

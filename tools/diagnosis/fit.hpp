@@ -18,11 +18,19 @@ struct FitProblem {
   std::vector<unsigned char> mask;  // samples whose residuals count (estimation part)
   std::vector<double> weight;       // per output: 1 / scale
   int max_iterations = 50;
+  // Weight of the priors (ParamSpec::prior): each free parameter with a
+  // prior adds the residual sqrt(prior_weight) (theta - init) / (prior init),
+  // in the units of the weighted output residuals. The engine sets it to the
+  // residual variance per effective sample, so the fit is a MAP estimate.
+  double prior_weight = 0.0;
 };
 
 struct FitResult {
   std::vector<double> theta;
   std::vector<double> sigma;  // standard deviation per parameter (0 for fixed ones; inf if not identifiable)
+  // Per parameter: the run did not determine it (a flat direction of the
+  // fit, or a posterior no narrower than 0.7 x its prior).
+  std::vector<bool> undetermined;
   double cost = 0.0;          // 0.5 * sum of squared weighted residuals on the mask
   int iterations = 0;
   bool rank_deficient = false;

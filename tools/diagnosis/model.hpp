@@ -27,6 +27,11 @@ struct ParamSpec {
   double null = 0.0;   // value at which the effect vanishes (unused for baseline parameters)
   std::vector<double> starts;  // extra start values for a non-convex scalar (grid in the screening)
   bool strength = false;       // the significance test of the effect uses this parameter
+  // Baseline parameters a real rig is uncertain about: the stated tolerance,
+  // the prior's standard deviation as a fraction of `init` (the nominal). The
+  // fit is regularised toward the nominal by it, so a parameter the run does
+  // not excite stays put and is reported as undetermined. 0: no prior.
+  double prior = 0.0;
 };
 
 struct EffectSpec {
@@ -53,6 +58,10 @@ class RigModel {
   // theta: baseline parameters then every effect's, in effects() order.
   // y: one vector per output, each time().size() long.
   virtual void simulate(const std::vector<double>& theta, std::vector<std::vector<double>>& y) const = 0;
+  // Whether baseline parameter `index` can change the outputs an effect of
+  // `cause` acts on: the screening frees only those (a rig of sub-models
+  // screens a sub-model's effect without replaying the others).
+  virtual bool couples(std::size_t /*index*/, const std::string& /*cause*/) const { return true; }
   // How the sub-model is replayed (goes into the JSON `validation` string).
   virtual std::string replay() const = 0;
   // Samples at the start that no model can match (state initialisation).

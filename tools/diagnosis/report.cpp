@@ -36,6 +36,31 @@ std::string json_fit_map(const std::map<std::string, double>& m) {
   return s + "}";
 }
 
+// {name: value}, null where the run does not determine the value.
+std::string json_values(const std::vector<ParamValue>& ps) {
+  std::string s = "{";
+  for (std::size_t j = 0; j < ps.size(); ++j)
+    s += (j ? ", " : "") + json_string(ps[j].name) + ": " + (ps[j].determined ? json_number(ps[j].value) : "null");
+  return s + "}";
+}
+
+std::string json_names_where(const std::vector<ParamValue>& ps, bool determined) {
+  std::string s = "[";
+  bool first = true;
+  for (const auto& p : ps)
+    if (p.determined == determined) {
+      s += (first ? "" : ", ") + json_string(p.name);
+      first = false;
+    }
+  return s + "]";
+}
+
+std::string json_list(const std::vector<std::string>& v) {
+  std::string s = "[";
+  for (std::size_t j = 0; j < v.size(); ++j) s += (j ? ", " : "") + json_string(v[j]);
+  return s + "]";
+}
+
 }  // namespace
 
 void write_json(const Diagnosis& d, std::ostream& out) {
@@ -44,30 +69,52 @@ void write_json(const Diagnosis& d, std::ostream& out) {
     const auto& c = d.causes[i];
     out << (i ? ",\n" : "\n") << "    {\"cause\": " << json_string(c.cause) << ", \"confidence\": " << json_number(c.confidence)
         << ",\n     \"evidence\": " << json_string(c.evidence) << ",\n     \"parameters\": {";
+    // A parameter the run cannot determine is null, not its starting value.
     for (std::size_t j = 0; j < c.parameters.size(); ++j)
-      out << (j ? ", " : "") << json_string(c.parameters[j].name) << ": " << json_number(c.parameters[j].value);
-    out << "},\n     \"parameter_sigma\": {";
+      out << (j ? ", " : "") << json_string(c.parameters[j].name) << ": "
+          << (c.parameters[j].determined ? json_number(c.parameters[j].value) : std::string("null"));
+    out << "},\n     \"undetermined_parameters\": " << json_names_where(c.parameters, false);
+    out << ",\n     \"parameter_sigma\": {";
     for (std::size_t j = 0; j < c.parameters.size(); ++j)
-      out << (j ? ", " : "") << json_string(c.parameters[j].name) << ": " << json_number(c.parameters[j].sigma);
+      out << (j ? ", " : "") << json_string(c.parameters[j].name) << ": "
+          << (c.parameters[j].determined ? json_number(c.parameters[j].sigma) : std::string("null"));
     out << "},\n     \"parameter_units\": {";
     for (std::size_t j = 0; j < c.parameters.size(); ++j)
       out << (j ? ", " : "") << json_string(c.parameters[j].name) << ": " << json_string(c.parameters[j].unit);
     out << "},\n     \"baseline_fit_percent\": " << json_number(c.baseline_fit_percent)
         << ", \"extended_fit_percent\": " << json_number(c.extended_fit_percent)
         << ", \"gain_percent_points\": " << json_number(c.gain_percent_points) << ", \"signal\": " << json_string(c.signal)
+        << ",\n     \"ambiguous_with\": " << json_list(c.ambiguous_with) << ", \"signature\": " << json_string(c.signature)
         << "}";
   }
   out << (d.causes.empty() ? "],\n" : "\n  ],\n");
   out << "  \"baseline_fit_percent\": " << json_fit_map(d.baseline_fit_percent) << ",\n";
   out << "  \"extended_fit_percent\": " << json_fit_map(d.extended_fit_percent) << ",\n";
   out << "  \"validation\": " << json_string(d.validation) << ",\n";
-  out << "  \"baseline_parameters\": {";
-  for (std::size_t j = 0; j < d.baseline_parameters.size(); ++j)
-    out << (j ? ", " : "") << json_string(d.baseline_parameters[j].name) << ": " << json_number(d.baseline_parameters[j].value);
-  out << "},\n  \"final_parameters\": {";
-  for (std::size_t j = 0; j < d.final_parameters.size(); ++j)
-    out << (j ? ", " : "") << json_string(d.final_parameters[j].name) << ": " << json_number(d.final_parameters[j].value);
-  out << "},\n  \"screened\": [";
+  out << "  \"unexplained\": " << (d.unexplained ? "true" : "false") << ",\n";
+  if (d.unexplained) {
+    const auto& u = d.unexplained_residual;
+    out << "  \"unexplained_residual\": {\"signal\": " << json_string(u.signal) << ", \"rms\": " << json_number(u.rms)
+        << ", \"noise_floor\": " << json_number(u.noise) << ", \"band_hz\": [" << json_number(u.band_lo_hz) << ", "
+        << json_number(u.band_hi_hz) << "], \"peak_hz\": " << json_number(u.peak_hz) << "},\n";
+  }
+  out << "  \"baseline_calibration\": [";
+  for (std::size_t j = 0; j < d.calibration.size(); ++j) {
+    const auto& c = d.calibration[j];
+    out << (j ? ",\n" : "\n") << "    {\"name\": " << json_string(c.name) << ", \"unit\": " << json_string(c.unit)
+        << ", \"nominal\": " << json_number(c.nominal)
+        << ", \"value\": " << (c.determined ? json_number(c.value) : std::string("null"))
+        << ", \"sigma\": " << (c.determined ? json_number(c.sigma) : std::string("null"))
+        << ", \"tolerance\": " << json_number(c.tolerance) << ", \"change_percent\": "
+        << (c.determined && c.nominal != 0.0 ? json_number(100.0 * (c.value - c.nominal) / c.nominal) : std::string("null"))
+        << ", \"moved\": " << (c.moved ? "true" : "false") << ", \"determined\": " << (c.determined ? "true" : "false")
+        << "}";
+  }
+  out << (d.calibration.empty() ? "],\n" : "\n  ],\n");
+  out << "  \"baseline_parameters\": " << json_values(d.baseline_parameters);
+  out << ",\n  \"final_parameters\": " << json_values(d.final_parameters);
+  out << ",\n  \"undetermined_parameters\": " << json_names_where(d.final_parameters, false);
+  out << ",\n  \"screened\": [";
   for (std::size_t j = 0; j < d.screened.size(); ++j) {
     const auto& s = d.screened[j];
     out << (j ? ",\n" : "\n") << "    {\"round\": " << s.round << ", \"cause\": " << json_string(s.cause)

@@ -1,5 +1,6 @@
 #include "tools/diagnosis/sweep.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <iomanip>
@@ -20,6 +21,7 @@ struct Job {
   std::string truth;  // cause id or "none"
   double level = 0.0;
   int seed = 1;
+  std::string second;  // a second effect (pairs), else empty
 };
 
 std::string level_name(double level) {
@@ -40,10 +42,12 @@ SweepResult run_sweep(const SweepOptions& o, const std::atomic<bool>& stop, std:
   r.labels.push_back("none");
   for (const auto& c : gen.causes) r.labels.push_back(c);
   std::vector<Job> jobs;
-  for (int k = 0; k < o.clean_runs; ++k) jobs.push_back({"none", 0.0, 100 + k});
+  for (int k = 0; k < o.clean_runs; ++k) jobs.push_back({"none", 0.0, 100 + k, {}});
   for (const auto& c : o.causes.empty() ? gen.causes : o.causes)
     for (double level : o.levels)
-      for (int seed : o.seeds) jobs.push_back({c, level, seed});
+      for (int seed : o.seeds) jobs.push_back({c, level, seed, {}});
+  for (const auto& [a, b] : o.pairs)
+    for (int seed : o.seeds) jobs.push_back({a, 1.0, seed, b});
 
   const std::string dir = o.scratch_dir.empty()
                               ? (std::filesystem::temp_directory_path() / ("rigctl_sweep_" + std::to_string(getpid())))
@@ -62,13 +66,15 @@ SweepResult run_sweep(const SweepOptions& o, const std::atomic<bool>& stop, std:
         i = next++;
       }
       const Job& j = jobs[i];
-      SweepCell cell{j.truth, level_name(j.level), "error", 0.0, 0.0};
+      SweepCell cell{j.second.empty() ? j.truth : j.truth + "+" + j.second, level_name(j.level), "error", 0.0, 0.0, {},
+                     false};
       const auto start = std::chrono::steady_clock::now();
       try {
         MakeRunOptions mr;
         mr.rig = rig;
         mr.config_path = o.config_path;
         if (j.truth != "none") mr.effects.emplace_back(j.truth, j.level);
+        if (!j.second.empty()) mr.effects.emplace_back(j.second, j.level);
         mr.seed = j.seed;
         mr.duration_s = o.duration_s;
         mr.out_csv = dir + "/run-" + std::to_string(i) + ".csv";
@@ -79,6 +85,8 @@ SweepResult run_sweep(const SweepOptions& o, const std::atomic<bool>& stop, std:
         const auto d = diag::diagnose(*model, {});
         cell.named = d.cause;
         if (!d.causes.empty()) cell.gain = d.causes.front().gain_percent_points;
+        for (const auto& c : d.causes) cell.all_named.push_back(c.cause);
+        cell.unexplained = d.unexplained;
         std::filesystem::remove(mr.out_csv);
       } catch (const std::exception& e) {
         cell.named = "error";
@@ -88,9 +96,12 @@ SweepResult run_sweep(const SweepOptions& o, const std::atomic<bool>& stop, std:
       std::lock_guard<std::mutex> lock(m);
       r.cells.push_back(cell);
       ++done;
-      progress << "  [" << done << "/" << jobs.size() << "] " << cell.truth << " (" << cell.level << ") -> "
-               << cell.named << (cell.named == cell.truth ? "" : "   <-- wrong") << "  " << std::fixed
-               << std::setprecision(1) << cell.seconds << " s\n";
+      std::string named;
+      for (const auto& c : cell.all_named) named += (named.empty() ? "" : "+") + c;
+      progress << "  [" << done << "/" << jobs.size() << "] " << cell.truth << " (" << cell.level << ", seed "
+               << j.seed << ") -> " << (named.empty() ? cell.named : named)
+               << (cell.unexplained ? " (unexplained)" : "") << (cell.named == cell.truth ? "" : "   <-- differs")
+               << "  " << std::fixed << std::setprecision(1) << cell.seconds << " s\n";
       progress.flush();
     }
   };
@@ -100,6 +111,16 @@ SweepResult run_sweep(const SweepOptions& o, const std::atomic<bool>& stop, std:
   if (o.scratch_dir.empty()) std::filesystem::remove_all(dir);
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   for (const auto& c : r.cells) {
+    const auto plus = c.truth.find('+');
+    if (plus != std::string::npos) {
+      const std::string a = c.truth.substr(0, plus), b = c.truth.substr(plus + 1);
+      const auto has = [&](const std::string& x) {
+        return std::find(c.all_named.begin(), c.all_named.end(), x) != c.all_named.end();
+      };
+      ++r.pairs_total;
+      if (has(a) && has(b)) ++r.pairs_found;
+      continue;
+    }
     ++r.confusion[c.truth][c.named];
     ++r.total;
     if (c.named == c.truth) ++r.correct;
@@ -132,7 +153,17 @@ void write_confusion_markdown(const SweepResult& r, std::ostream& out) {
     out << " " << ok << "/" << n << " |\n";
   }
   out << "\nAccuracy " << r.correct << "/" << r.total << " (" << std::fixed << std::setprecision(1)
-      << (r.total ? 100.0 * r.correct / r.total : 0.0) << " %), " << std::setprecision(0) << r.wall_s << " s wall.\n";
+      << (r.total ? 100.0 * r.correct / r.total : 0.0) << " %)";
+  if (r.pairs_total > 0) {
+    out << "; two-effect runs with both named " << r.pairs_found << "/" << r.pairs_total << ":";
+    for (const auto& c : r.cells)
+      if (c.truth.find('+') != std::string::npos) {
+        std::string named;
+        for (const auto& x : c.all_named) named += (named.empty() ? "" : "+") + x;
+        out << " " << c.truth << " -> " << (named.empty() ? "none" : named) << ";";
+      }
+  }
+  out << " " << std::setprecision(0) << r.wall_s << " s wall.\n";
 }
 
 }  // namespace rigctl

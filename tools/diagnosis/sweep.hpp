@@ -18,7 +18,10 @@ struct SweepOptions {
   std::string config_path;             // default config/<rig>.yaml
   std::vector<std::string> causes;     // empty: every cause id of the rig
   std::vector<double> levels{0.35, 1.0};
-  std::vector<int> seeds{11};
+  std::vector<int> seeds{11, 12};     // two seeds: each cause in both physical forms (form = seed % 2)
+  // Runs with two effects at the strong level, once per seed; scored by
+  // whether both are named (two-effect recall).
+  std::vector<std::pair<std::string, std::string>> pairs;
   int clean_runs = 3;                  // runs with nothing hidden (expect "none")
   int threads = 2;
   double duration_s = 0.0;             // 0: the excitation's length
@@ -26,16 +29,19 @@ struct SweepOptions {
 };
 
 struct SweepCell {
-  std::string truth, level, named;  // level: "weak", "strong" or "clean"
+  std::string truth, level, named;  // level: "weak", "strong" or "clean"; truth "a+b" for a pair
   double seconds = 0.0;
   double gain = 0.0;  // of the named cause (0 for none)
+  std::vector<std::string> all_named;
+  bool unexplained = false;
 };
 
 struct SweepResult {
   std::vector<std::string> labels;  // "none" then the rig's cause ids
   std::map<std::string, std::map<std::string, int>> confusion;  // truth -> named -> count
   std::vector<SweepCell> cells;
-  int correct = 0, total = 0;
+  int correct = 0, total = 0;       // single-effect and clean runs: top cause right
+  int pairs_found = 0, pairs_total = 0;  // two-effect runs: both named
   double wall_s = 0.0;
 };
 

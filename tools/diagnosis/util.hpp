@@ -62,4 +62,13 @@ inline ParamSpec P(const std::string& name, const std::string& unit, double init
   return p;
 }
 
+// A baseline parameter with a prior of relative tolerance `tol` about its
+// nominal value (docs/diagnosis.md 4).
+inline ParamSpec Prior(const std::string& name, const std::string& unit, double nominal, double tol,
+                       double lo_factor = 0.3, double hi_factor = 3.0) {
+  ParamSpec p = P(name, unit, nominal, nominal * lo_factor, nominal * hi_factor, std::abs(nominal) * tol);
+  p.prior = tol;
+  return p;
+}
+
 }  // namespace rigctl::diag

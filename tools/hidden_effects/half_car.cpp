@@ -12,8 +12,13 @@
 //                     switching at zero rate; fit: a tanh blend
 //   sensor_delay      driver: the transducers' delay, cubic interpolation of
 //                     the true signal; fit: linear interpolation
+// Second forms (form 1): a first-order actuator; a digressive rebound damper
+// (knee at 0.1 m/s); shorter, sharper humps that throw the wheels; a
+// 2nd-order Butterworth conditioning filter instead of a pure delay.
 #include <stdexcept>
 
+#include "drivers/sim/conditioning_filter.hpp"
+#include "tools/hidden_effects/perturbation.hpp"
 #include "tools/hidden_effects/rigs.hpp"
 
 namespace rigctl {
@@ -30,12 +35,13 @@ void make_clean(RigConfig& c) {
   p.actuator_time_constant = 0.0;
   p.actuator_valve_time_constant = 0.0;
   p.actuator_force_limit = 0.0;  // the controller clamps; a plant saturation would be an unmodelled effect
+  p.damper_rebound_knee = 0.0;
   // The road is the case's: its humps are sized so that both tyres keep
   // contact (config/half_car.yaml, case `diagnosis`). Lift-off is not switched
   // off here because it is not a switch: it is what a harsher road does.
 }
 
-AppliedEffect apply(RigConfig& c, const std::string& cause, double level) {
+AppliedEffect apply(RigConfig& c, const std::string& cause, double level, int form) {
   AppliedEffect a;
   a.cause = cause;
   a.level = level;
@@ -48,6 +54,14 @@ AppliedEffect apply(RigConfig& c, const std::string& cause, double level) {
     // actuator whose mean delay tau1 + tau2 is what a first-order fit finds
     // at the body and wheel frequencies.
     const double tau = 0.020 * level;
+    if (form == 1) {
+      p.actuator_time_constant = tau;
+      a.form = "first_order";
+      a.truth = {{"tau_a", tau}};
+      a.description = "first-order actuator, " + std::to_string(tau) + " s";
+      return a;
+    }
+    a.form = "second_order";
     p.actuator_time_constant = 0.6 * tau;
     p.actuator_valve_time_constant = 0.4 * tau;
     a.truth = {{"tau_a", tau}, {"tau_force_loop", 0.6 * tau}, {"tau_valve", 0.4 * tau}};
@@ -58,8 +72,12 @@ AppliedEffect apply(RigConfig& c, const std::string& cause, double level) {
   if (cause == "damper_asymmetry") {
     // Strong: rebound damping twice compression (production dampers are built
     // 2-3 : 1; the baseline assumes 1 : 1). Level scales the excess ratio.
-    const double f = 1.0 + 1.0 * level;
+    // Form 1: digressive, the rebound force's slope drops to a third above
+    // 0.1 m/s, so the excess ratio at low speed is larger for a like size.
+    const double f = 1.0 + (form == 0 ? 1.0 : 1.5) * level;
     p.damper_rebound_factor = f;
+    p.damper_rebound_knee = form == 0 ? 0.0 : 0.1;
+    a.form = form == 0 ? "piecewise_linear" : "digressive";
     // The fit's c (1 +- asym) with c the mean: asym = (f - 1) / (f + 1).
     a.truth = {{"asym", (f - 1.0) / (f + 1.0)}, {"rebound_factor", f}};
     a.description = "piecewise-linear dampers, rebound " + std::to_string(f) + " x compression";
@@ -78,7 +96,14 @@ AppliedEffect apply(RigConfig& c, const std::string& cause, double level) {
     auto& tr = p.road.train;
     if (tr.count <= 0 || tr.amplitude == 0.0)
       throw std::invalid_argument("half_car: tyre_liftoff needs a case whose road has a bump train (case 'diagnosis')");
-    tr.amplitude *= 1.0 + 6.0 * level;
+    if (form == 1) {
+      tr.amplitude *= 1.0 + 5.0 * level;
+      tr.wavelength *= 0.6;  // shorter humps: a sharper kick at the same speed
+      a.form = "short_humps";
+    } else {
+      tr.amplitude *= 1.0 + 6.0 * level;
+      a.form = "tall_humps";
+    }
     a.truth = {{"unilateral", 1.0}, {"hump_height_m", tr.amplitude}};
     a.description = "road humps raised to " + std::to_string(tr.amplitude) + " m: the sharp unilateral tyre leaves the ground";
     return a;
@@ -87,12 +112,38 @@ AppliedEffect apply(RigConfig& c, const std::string& cause, double level) {
     // Strong: 8 ms, about three samples, an anti-alias filter plus a slow
     // conversion chain; weak 2.8 ms is about one sample.
     const double tau = 0.008 * level;
-    for (const char* ch : kOutputs) c.sensors[ch].delay_s = tau;
+    for (const char* ch : kOutputs) {
+      if (form == 0) c.sensors[ch].delay_s = tau;
+      else c.sensors[ch].filter_hz = ConditioningFilter::cutoff_for_delay(tau);
+    }
+    a.form = form == 0 ? "pure_delay" : "butterworth_filter";
     a.truth = {{"tau", tau}};
     a.description = "z_s, phi, z_u1, z_u2 transducers delayed by " + std::to_string(tau) + " s (cubic interpolation)";
     return a;
   }
   throw std::invalid_argument("half_car: no hidden effect '" + cause + "'");
+}
+
+// Every vehicle parameter within the tolerance (geometry too: a loaded car's
+// centre of gravity moves); the controller drawn among fuzzy, skyhook and
+// LQR (the diagnosis replays the commanded forces, whatever made them); the
+// random road's seed from the run's, the humps 0.9-1.1 in height and spacing.
+void perturb(RigConfig& c, Perturbation& d, const std::string& /*scratch*/) {
+  auto& p = c.half_car;
+  for (auto [name, v] : std::initializer_list<std::pair<const char*, double*>>{
+           {"mass_body", &p.mass_body}, {"inertia_body", &p.inertia_body}, {"dist_front", &p.dist_front},
+           {"dist_rear", &p.dist_rear}, {"mass_unsprung_1", &p.mass_unsprung_1},
+           {"mass_unsprung_2", &p.mass_unsprung_2}, {"spring_1", &p.spring_1}, {"spring_2", &p.spring_2},
+           {"damper_1", &p.damper_1}, {"damper_2", &p.damper_2}, {"tyre_stiffness_1", &p.tyre_stiffness_1},
+           {"tyre_stiffness_2", &p.tyre_stiffness_2}})
+    d.scale(name, *v);
+  if (!d.active()) return;
+  static constexpr ControllerKind kControllers[] = {ControllerKind::kFuzzy, ControllerKind::kSkyhook,
+                                                     ControllerKind::kLqr};
+  c.controller.type = kControllers[d.pick("controller", 3)];
+  p.road.iso.seed = static_cast<uint64_t>(d.factor("road_seed", 1.0, 1000.0));
+  p.road.train.amplitude *= d.factor("hump_height", 0.9, 1.1);
+  p.road.train.interval *= d.factor("hump_spacing", 0.9, 1.1);
 }
 
 }  // namespace
@@ -104,6 +155,7 @@ const RigEffectGenerator& half_car_effect_generator() {
       "diagnosis",
       make_clean,
       apply,
+      perturb,
   };
   return g;
 }

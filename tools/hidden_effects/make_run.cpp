@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "rt/parse_number.hpp"
+#include "tools/hidden_effects/perturbation.hpp"
 #include "tools/hidden_effects/rigs.hpp"
 #include "tools/common/json_text.hpp"
 #include "tools/run/run_command.hpp"
@@ -34,14 +35,23 @@ const RigEffectGenerator& effect_generator(const std::string& rig) { return effe
 
 namespace {
 
-void write_truth(const std::string& path, const MakeRunOptions& o, const std::vector<AppliedEffect>& applied) {
+void write_truth(const std::string& path, const MakeRunOptions& o, const std::vector<AppliedEffect>& applied,
+                 const Perturbation& draw) {
   std::ofstream f(path);
   if (!f) throw std::runtime_error("cannot write the truth file '" + path + "'");
-  f << "{\n  \"rig\": " << json_string(std::string(to_string(o.rig))) << ",\n  \"seed\": " << o.seed << ",\n  \"effects\": [";
+  f << "{\n  \"rig\": " << json_string(std::string(to_string(o.rig))) << ",\n  \"seed\": " << o.seed
+    << ",\n  \"tolerance\": " << json_number(o.tolerance) << ",\n  \"drawn\": {";
+  bool first_draw = true;
+  for (const auto& [k, v] : draw.drawn()) {
+    f << (first_draw ? "" : ", ") << json_string(k) << ": " << json_number(v);
+    first_draw = false;
+  }
+  f << "},\n  \"effects\": [";
   for (std::size_t i = 0; i < applied.size(); ++i) {
     const auto& a = applied[i];
     f << (i ? ",\n" : "\n") << "    {\"cause\": " << json_string(a.cause) << ", \"level\": " << json_number(a.level)
-      << ", \"description\": " << json_string(a.description) << ", \"truth\": {";
+      << ", \"form\": " << json_string(a.form) << ", \"description\": " << json_string(a.description)
+      << ", \"truth\": {";
     bool first = true;
     for (const auto& [k, v] : a.truth) {
       f << (first ? "" : ", ") << json_string(k) << ": " << json_number(v);
@@ -75,11 +85,18 @@ std::vector<AppliedEffect> make_run(const MakeRunOptions& o, std::ostream& progr
     s.delay_s = 0.0;
   }
   gen.make_clean(config);
+  if (o.form >= kForms) throw std::invalid_argument("effect form " + std::to_string(o.form) + ": expected 0 or 1");
+  const int form = o.form >= 0 ? o.form : o.seed % kForms;
   std::vector<AppliedEffect> applied;
   for (const auto& [cause, level] : o.effects) {
     if (cause == "none") continue;
-    applied.push_back(gen.apply(config, cause, level));
+    applied.push_back(gen.apply(config, cause, level, form));
   }
+  if (!(o.tolerance >= 0.0 && o.tolerance < 0.5))
+    throw std::invalid_argument("parameter tolerance must be in [0, 0.5)");
+  Perturbation draw(static_cast<uint64_t>(o.seed), o.tolerance);
+  const std::string scratch = o.out_csv + ".demand";
+  gen.perturb(config, draw, scratch);
 
   RunOptions run;
   run.config_path = config_path;
@@ -95,6 +112,7 @@ std::vector<AppliedEffect> make_run(const MakeRunOptions& o, std::ostream& progr
   const RunReport report = run_rig(config, run, stop, progress);
   std::filesystem::remove(run.log_path);
   std::filesystem::remove(run.log_path + ".events");  // the event log beside it (SAFETY.md)
+  std::filesystem::remove(scratch + ".csv");             // a varied demand table, if the rig made one
   // Simulated time waits for the publisher instead of dropping
   // (rt/queue_full_policy.hpp): a gap here is a bug, never a run file.
   if (report.loop.dropped_records > 0) {
@@ -105,7 +123,7 @@ std::vector<AppliedEffect> make_run(const MakeRunOptions& o, std::ostream& progr
     throw std::runtime_error("the generated run ended " + std::string(to_string(report.loop.final_state)) +
                              " (a hidden effect too strong for the rig's limits?)");
   }
-  if (!o.truth_json.empty()) write_truth(o.truth_json, o, applied);
+  if (!o.truth_json.empty()) write_truth(o.truth_json, o, applied, draw);
   return applied;
 }
 

@@ -12,9 +12,19 @@
 // the dither is part of the model, not a cause) and the diagnosis replays it.
 //
 // Levels: 1 is strong, weak_level() = 0.35 of each physical size below.
+// Two physical forms of each effect (form 0 / form 1):
+//   bladder_hysteresis   modified trapezoid, stick/slip   / Bouc-Wen loop (smooth bend into saturation)
+//   coulomb_friction     brake, exact stick/slip          / smooth Simscape friction with a Stribeck peak
+//   polytropic_exponent  constant n                       / n from isothermal at rest to adiabatic at speed
+//   valve_null_offset    electrical, before the dither    / mechanical spool shift, after it
+//   valve_deadband       sharp lands                      / rounded metering edges
+//   sensor_delay         cubic delay line                 / 2nd-order Butterworth conditioning filter
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 
+#include "drivers/sim/conditioning_filter.hpp"
+#include "tools/hidden_effects/perturbation.hpp"
 #include "tools/hidden_effects/rigs.hpp"
 
 namespace rigctl {
@@ -51,9 +61,10 @@ void make_clean(RigConfig& c) {
   p.heat_capacity_ratio = 1.4;  // adiabatic, the seed's and the diagnosis baseline's
   p.valve_null_offset = 0.0;
   p.valve_overlap = 0.0;
+  p.forms = PneumaticHiddenForms{};
 }
 
-AppliedEffect apply(RigConfig& c, const std::string& cause, double level) {
+AppliedEffect apply(RigConfig& c, const std::string& cause, double level, int form) {
   auto& p = c.pneumatic_rotary;
   AppliedEffect a;
   a.cause = cause;
@@ -61,9 +72,20 @@ AppliedEffect apply(RigConfig& c, const std::string& cause, double level) {
   if (cause == "bladder_hysteresis") {
     // The plant's modified trapezoid (plant/bladder_hysteresis.*) with its
     // default shape: half the swing stepwise, the rest over 2 deg of travel.
+    const double H = kHysteresisLevel * level * p.max_torque;
+    if (form == 1) {
+      // Bouc-Wen with the same half-width; its initial slope H / 0.02 rad
+      // reaches the trapezoid's level over about the same travel.
+      p.forms.bouc_wen_level = kHysteresisLevel * level;
+      a.form = "bouc_wen";
+      a.truth = {{"H", H}};
+      a.description = "bladder hysteresis, Bouc-Wen loop of +-" + std::to_string(100.0 * kHysteresisLevel * level) +
+                      " % of max torque (H = " + std::to_string(H) + " N m)";
+      return a;
+    }
+    a.form = "trapezoid";
     p.hysteresis.enabled = true;
     p.hysteresis.level = kHysteresisLevel * level;
-    const double H = p.hysteresis.level * p.max_torque;
     a.truth = {{"H", H},
                {"h_s", H * p.hysteresis.step_fraction},
                {"T_e", H * (1.0 - p.hysteresis.step_fraction)},
@@ -73,6 +95,15 @@ AppliedEffect apply(RigConfig& c, const std::string& cause, double level) {
     return a;
   }
   if (cause == "coulomb_friction") {
+    if (form == 1) {
+      p.forms.smooth_friction_level = kBrakeLevel * level;
+      a.form = "smooth_stribeck";
+      a.truth = {{"T_c", kBrakeLevel * level * p.max_torque}};
+      a.description = "smooth Coulomb friction with a Stribeck peak at " + std::to_string(100.0 * kBrakeLevel * level) +
+                      " % of max torque";
+      return a;
+    }
+    a.form = "stick_slip";
     p.brake.enabled = true;
     p.brake.level = kBrakeLevel * level;
     a.truth = {{"T_c", p.brake.level * p.max_torque}};
@@ -81,12 +112,30 @@ AppliedEffect apply(RigConfig& c, const std::string& cause, double level) {
     return a;
   }
   if (cause == "polytropic_exponent") {
+    if (form == 1) {
+      // Heat transfer that depends on speed: isothermal-ward at rest,
+      // adiabatic at speed (corner 0.3 rad/s, the rig's typical step speed).
+      p.forms.polytropic_slow = 1.4 - (1.4 - kIsothermalN) * level;
+      a.form = "speed_dependent";
+      a.truth = {{"n_at_rest", p.forms.polytropic_slow}};
+      a.description = "polytropic exponent from " + std::to_string(p.forms.polytropic_slow) + " at rest to 1.4 at speed";
+      return a;
+    }
+    a.form = "constant";
     p.heat_capacity_ratio = 1.4 - (1.4 - kIsothermalN) * level;
     a.truth = {{"n", p.heat_capacity_ratio}};
     a.description = "chamber gas polytropic exponent " + std::to_string(p.heat_capacity_ratio) + " instead of 1.4";
     return a;
   }
   if (cause == "valve_null_offset") {
+    if (form == 1) {
+      p.forms.spool_null_shift = kNullOffsetV * level * p.solenoid_gain;
+      a.form = "spool_shift";
+      a.truth = {{"u0", kNullOffsetV * level}};
+      a.description = "spool null shifted " + std::to_string(p.forms.spool_null_shift * 1e3) + " mm";
+      return a;
+    }
+    a.form = "electrical";
     p.valve_null_offset = kNullOffsetV * level;
     a.truth = {{"u0", p.valve_null_offset}};
     a.description = "valve null offset " + std::to_string(p.valve_null_offset) + " V";
@@ -94,6 +143,8 @@ AppliedEffect apply(RigConfig& c, const std::string& cause, double level) {
   }
   if (cause == "valve_deadband") {
     p.valve_overlap = kOverlapV * level * p.solenoid_gain;
+    p.forms.overlap_edge_radius = form == 0 ? 0.0 : 0.5 * p.valve_overlap;
+    a.form = form == 0 ? "sharp" : "rounded";
     a.truth = {{"delta", kOverlapV * level}, {"overlap_m", p.valve_overlap}};
     a.description = "spool overlap " + std::to_string(p.valve_overlap * 1e3) + " mm (" +
                     std::to_string(kOverlapV * level) + " V of command): sharp dead band";
@@ -101,12 +152,39 @@ AppliedEffect apply(RigConfig& c, const std::string& cause, double level) {
   }
   if (cause == "sensor_delay") {
     const double tau = kDelayS * level;
-    for (const char* s : {"theta", "dp", "omega"}) c.sensors[s].delay_s = tau;
+    for (const char* s : {"theta", "dp", "omega"}) {
+      if (form == 0) c.sensors[s].delay_s = tau;
+      else c.sensors[s].filter_hz = ConditioningFilter::cutoff_for_delay(tau);
+    }
+    a.form = form == 0 ? "pure_delay" : "butterworth_filter";
     a.truth = {{"tau", tau}};
     a.description = "theta, dp and omega transducers delayed by " + std::to_string(tau * 1e3) + " ms";
     return a;
   }
   throw std::invalid_argument("pneumatic_rotary: no hidden effect '" + cause + "'");
+}
+
+// Every plant parameter within the tolerance (max_torque is the reference
+// of the per-cent levels, not a property of the rig); Ke within +-15 %
+// (3.1-4.3 V/rad: stable at both payloads, the paper's unstable case is
+// 7.4) and a velocity gain 0-0.2 V/(rad/s) (Fig. 6 uses 0.3); each step of
+// the demand scaled 0.85-1.1 and the holds 0.85-1.15.
+void perturb(RigConfig& c, Perturbation& d, const std::string& /*scratch*/) {
+  auto& p = c.pneumatic_rotary;
+  for (auto [name, v] : std::initializer_list<std::pair<const char*, double*>>{
+           {"solenoid_gain", &p.solenoid_gain}, {"spool_limit", &p.spool_limit}, {"flow_gain", &p.flow_gain},
+           {"flow_pressure_coefficient", &p.flow_pressure_coefficient}, {"dither_amplitude", &p.dither_amplitude},
+           {"chamber_volume", &p.chamber_volume}, {"quiescent_pressure", &p.quiescent_pressure},
+           {"supply_temperature", &p.supply_temperature}, {"first_moment", &p.first_moment},
+           {"inertia", &p.inertia}})
+    d.scale(name, *v);
+  d.scale("pvp_ke", c.controller.pvp.ke, 0.15);
+  if (d.active()) c.controller.pvp.kv = 0.2 * d.factor("pvp_kv_share", 0.0, 1.0);
+  if (d.active() && c.profile.type == ProfileKind::kRampSteps) {
+    for (std::size_t i = 0; i < c.profile.steps.size(); ++i)
+      c.profile.steps[i] = std::clamp(c.profile.steps[i] * d.factor("step_" + std::to_string(i), 0.85, 1.1), -0.8, 0.8);
+    c.profile.step_hold_s *= d.factor("step_hold", 0.85, 1.15);
+  }
 }
 
 }  // namespace
@@ -119,6 +197,7 @@ const RigEffectGenerator& pneumatic_rotary_effect_generator() {
       "diagnosis",
       make_clean,
       apply,
+      perturb,
   };
   return g;
 }

@@ -122,8 +122,16 @@ class HalfCarDiagModel : public RigModel {
   const std::vector<Output>& outputs() const override { return outputs_; }
   const std::vector<double>& time() const override { return t_; }
   std::vector<ParamSpec> baseline() const override {
-    return {P("c_1", "N s/m", p_.damper_1, 0.0, 1e5, std::max(100.0, p_.damper_1)),
-            P("c_2", "N s/m", p_.damper_2, 0.0, 1e5, std::max(100.0, p_.damper_2))};
+    // The two dampers (the least certain catalogue values, 10 %) and every
+    // other value of the vehicle with a prior of 5 %: a car on a rig is never
+    // its data sheet (load, tyre pressure, bushings).
+    const auto& p = p_;
+    return {Prior("c_1", "N s/m", p.damper_1, 0.10),        Prior("c_2", "N s/m", p.damper_2, 0.10),
+            Prior("k_1", "N/m", p.spring_1, 0.05),          Prior("k_2", "N/m", p.spring_2, 0.05),
+            Prior("kt_1", "N/m", p.tyre_stiffness_1, 0.05), Prior("kt_2", "N/m", p.tyre_stiffness_2, 0.05),
+            Prior("m_s", "kg", p.mass_body, 0.05),          Prior("I", "kg m^2", p.inertia_body, 0.05),
+            Prior("m_u1", "kg", p.mass_unsprung_1, 0.05),   Prior("m_u2", "kg", p.mass_unsprung_2, 0.05),
+            Prior("l_1", "m", std::abs(lever_[0]), 0.05),   Prior("l_2", "m", std::abs(lever_[1]), 0.05)};
   }
   std::vector<EffectSpec> effects() const override {
     // Start grids: the lag and the delay are non-convex scalars; a second start
@@ -151,14 +159,20 @@ class HalfCarDiagModel : public RigModel {
 
   void simulate(const std::vector<double>& th, std::vector<std::vector<double>>& y) const override {
     const double c[2] = {th[0], th[1]};
-    const double tau_a = th[2], uni = th[3], asym = th[4], tau_s = th[5];
+    const double k[2] = {th[2], th[3]};
+    const double kt[2] = {th[4], th[5]};
+    const double ms = th[6], inertia = th[7];
+    const double mu[2] = {th[8], th[9]};
+    const double lever[2] = {th[10], -th[11]};
+    const double tau_a = th[12], uni = th[13], asym = th[14], tau_s = th[15];
     const std::size_t n = t_.size();
     y.assign(4, std::vector<double>(n, 0.0));
-    const double k[2] = {p_.spring_1, p_.spring_2};
-    const double kt[2] = {p_.tyre_stiffness_1, p_.tyre_stiffness_2};
     const double ct[2] = {p_.tyre_damping_1, p_.tyre_damping_2};
-    const double mu[2] = {p_.mass_unsprung_1, p_.mass_unsprung_2};
-    const double eps[2] = {kTyreBand * static_load_[0], kTyreBand * static_load_[1]};
+    // Static tyre loads of these masses and lever arms (the body's weight
+    // shared by the arms, as half_car_static_tyre_load).
+    const double static_load[2] = {mu[0] * p_.gravity + ms * p_.gravity * (-lever[1]) / (lever[0] - lever[1]),
+                                   mu[1] * p_.gravity + ms * p_.gravity * lever[0] / (lever[0] - lever[1])};
+    const double eps[2] = {kTyreBand * static_load[0], kTyreBand * static_load[1]};
     const double h = dt_ / kSubsteps;
     const double decay_h = tau_a > 1e-6 ? std::exp(-0.5 * h / tau_a) : 0.0;  // lag over half a sub-step
     // q = [z_s, phi, z_u1, z_u2, v_s, omega, v_u1, v_u2]
@@ -168,22 +182,22 @@ class HalfCarDiagModel : public RigModel {
                      double m_roll, std::array<double, 8>& d) {
       double heave = 0.0, moment = m_roll;
       for (std::size_t w = 0; w < 2; ++w) {
-        const double l = lever_[w];
+        const double l = lever[w];
         const double travel = s[0] + l * s[1] - s[2 + w];
         const double rate = s[4] + l * s[5] - s[6 + w];
         const double damp = c[w] * (1.0 + (asym != 0.0 ? asym * std::tanh(rate / kRateBand) : 0.0)) * rate;
         const double fb = -k[w] * travel - damp + fact[w];
         heave += fb;
         moment += l * fb;
-        const double ft = static_load_[w] + kt[w] * (zr[w] - s[2 + w]) + ct[w] * (vr[w] - s[6 + w]);
+        const double ft = static_load[w] + kt[w] * (zr[w] - s[2 + w]) + ct[w] * (vr[w] - s[6 + w]);
         const double fe = uni > 0.0 ? (1.0 - uni) * ft + uni * softplus(ft, eps[w]) : ft;
         d[2 + w] = s[6 + w];
-        d[6 + w] = (fe - static_load_[w] - fb) / mu[w];
+        d[6 + w] = (fe - static_load[w] - fb) / mu[w];
       }
       d[0] = s[4];
       d[1] = s[5];
-      d[4] = heave / p_.mass_body;
-      d[5] = moment / p_.inertia_body;
+      d[4] = heave / ms;
+      d[5] = moment / inertia;
     };
     std::array<double, 8> k1, k2, k3, k4, s;
     for (std::size_t i = 0; i < n; ++i) {
@@ -241,7 +255,7 @@ class HalfCarDiagModel : public RigModel {
     // a displacement-equivalent [m] so that it shares the residual's axis.
     std::vector<double> out(rate1_.size());
     for (std::size_t i = 0; i < out.size(); ++i)
-      out[i] = th[0] * th[4] * std::tanh(rate1_[i] / kRateBand) * rate1_[i] / p_.spring_1;
+      out[i] = th[0] * th[14] * std::tanh(rate1_[i] / kRateBand) * rate1_[i] / th[2];
     return out;
   }
 

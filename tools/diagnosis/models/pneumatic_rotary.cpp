@@ -52,6 +52,7 @@
 #include "config/rig_config.hpp"
 #include "rt/control/pvp_controller.hpp"
 #include "tools/diagnosis/model.hpp"
+#include "tools/diagnosis/models/controller_from_record.hpp"
 #include "tools/diagnosis/rigs.hpp"
 #include "tools/diagnosis/util.hpp"
 
@@ -116,7 +117,7 @@ class PneumaticRotaryModel : public RigModel {
     pvp_.angle_input = 0;
     pvp_.pressure_input = 1;
     pvp_.output_index = 0;
-    source_ = source;
+    source_ = source + "; " + calibrate_pvp(pvp_, run.col("theta_d"), run.col("theta"), run.col("dp"), run.col("u"));
     theta_d_ = run.col("theta_d");
     outputs_ = {{"theta", run.col("theta")}, {"dp", run.col("dp")}};
     u_meas_ = run.col("u");
@@ -144,7 +145,22 @@ class PneumaticRotaryModel : public RigModel {
     // The payload is the least certain nominal value (the paper runs 1.7 and
     // 0.4 kg m^2); a viscous term lets the baseline take up damping that is
     // not an effect of the library before an effect is credited with it.
-    return {P("I", "kg m^2", p_.inertia, 0.02, 50.0, p_.inertia), P("b", "N m s/rad", 0.0, 0.0, 100.0, 0.5)};
+    // The rest of the rig's uncertain values with priors of their tolerance
+    // (5 %: valve coefficients, volume, quiescent pressure, moment of area,
+    // dither amplitude), so a rig a few per cent off nominal is calibrated
+    // before any effect is credited with the difference.
+    const auto& p = p_;
+    // The payload: the least certain value (the paper runs 1.7 and 0.4 kg m^2
+    // on one rig), so a wide prior of 30 %: a strong effect must not be able
+    // to drag it to its bound before any candidate is tried.
+    return {Prior("I", "kg m^2", p.inertia, 0.30, 0.05, 20.0),
+            P("b", "N m s/rad", 0.0, 0.0, 100.0, 0.5),
+            Prior("C1", "kg/(s m)", p.flow_gain, 0.05),
+            Prior("C2", "kg/(s Pa)", p.flow_pressure_coefficient, 0.05),
+            Prior("V", "m^3", p.chamber_volume, 0.05),
+            Prior("Pq", "Pa", p.quiescent_pressure, 0.05),
+            Prior("alpha", "m^3/rad", p.first_moment, 0.05),
+            Prior("dither", "V", std::max(p.dither_amplitude, 1e-3), 0.05)};
   }
   std::vector<EffectSpec> effects() const override {
     return {
@@ -173,7 +189,7 @@ class PneumaticRotaryModel : public RigModel {
     };
   }
   std::string replay() const override {
-    return "closed-loop replay: theta_d through the rig's P+V+dP controller (rt/pvp_controller, gains from " + source_ +
+    return "closed-loop replay: theta_d through the rig's P+V+dP controller (rt/pvp_controller; " + source_ +
            ") and the reduced pneumatic plant (valve, differential chamber pressure, rotor), controller at the run's "
            "period with the command held, " + std::to_string(kSubsteps) +
            " semi-implicit sub-steps per period; the valve dither is kept, averaged over its phase (mean flow and "
@@ -201,7 +217,7 @@ class PneumaticRotaryModel : public RigModel {
     std::vector<std::vector<double>> y;
     std::vector<double> torque;
     run(th, y, &torque, cause == "coulomb_friction" ? 2 : 1);
-    for (auto& v : torque) v /= p_.first_moment;
+    for (auto& v : torque) v /= th[6];
     return torque;
   }
 
@@ -209,21 +225,22 @@ class PneumaticRotaryModel : public RigModel {
   // which: 1 hysteresis torque, 2 Coulomb torque, into *torque per sample.
   void run(const std::vector<double>& th, std::vector<std::vector<double>>& y, std::vector<double>* torque,
            int which = 0) const {
-    const double I = th[0], b = th[1], hs = th[2], te = th[3], thr = std::max(th[4], 1e-4), tc = th[5], nexp = th[6],
-                 u0 = th[7], delta = th[8], tau = th[9];
+    const double I = th[0], b = th[1], C1 = th[2], C2 = th[3], V = th[4], Pq = th[5], alpha = th[6], dither = th[7];
+    const double hs = th[8], te = th[9], thr = std::max(th[10], 1e-4), tc = th[11], nexp = th[12], u0 = th[13],
+                 delta = th[14], tau = th[15];
     const std::size_t N = t_.size();
     y.assign(2, std::vector<double>(N, 0.0));
     if (torque) torque->assign(N, 0.0);
     const auto& p = p_;
-    const double gas = nexp * p.gas_constant * p.supply_temperature / p.chamber_volume;  // n R T / V
-    const double mot = nexp * p.quiescent_pressure * p.first_moment / p.chamber_volume;  // n Pq alpha / V
-    const double leak = gas * p.flow_pressure_coefficient;                               // 1 / tau_chamber
+    const double gas = nexp * p.gas_constant * p.supply_temperature / V;  // n R T / V
+    const double mot = nexp * Pq * alpha / V;                             // n Pq alpha / V
+    const double leak = gas * C2;                                         // 1 / tau_chamber
     const double Lv = p.spool_limit / p.solenoid_gain;
-    const double A = p.dither ? p.dither_amplitude : 0.0;
+    const double A = p.dither ? dither : 0.0;
     const double A_avg = std::max(A, kMinSmoothingV);
     const double W = 2.0 * kPi * p.dither_frequency;
     // dp ripple of a fundamental F [V] of the opening: 2 n R T/V C1 k F (a sin - W cos) / (W^2 + a^2).
-    const double ripple_gain = A > 0.0 ? 2.0 * gas * p.flow_gain * p.solenoid_gain / (W * W + leak * leak) : 0.0;
+    const double ripple_gain = A > 0.0 ? 2.0 * gas * C1 * p.solenoid_gain / (W * W + leak * leak) : 0.0;
     // At t_k - tau: the dither phase of t_k turned back by W tau.
     const double cd = std::cos(W * tau), sd = std::sin(W * tau);
     auto ripple = [&](std::size_t k, double fundamental) {
@@ -263,7 +280,7 @@ class PneumaticRotaryModel : public RigModel {
       ctrl.update(theta_d_[k], sample, cmd, terms);
       const auto op = opening(cmd.value[0]);
       fund_prev = A > 0.0 ? op.fundamental : 0.0;
-      const double flow = 2.0 * p.flow_gain * p.solenoid_gain * op.mean;  // 2 C1 x_o [kg/s]
+      const double flow = 2.0 * C1 * p.solenoid_gain * op.mean;  // 2 C1 x_o [kg/s]
       // Each sub-step is split symmetrically (Strang): half a step of the
       // chambers, the rotor over the whole step, the other half of the
       // chambers with the new speed; the angle and the Dahl travel use the
@@ -272,7 +289,7 @@ class PneumaticRotaryModel : public RigModel {
       for (int j = 0; j < kSubsteps; ++j) {
         dp += 0.5 * h * (gas * flow - leak * dp - 2.0 * mot * omega);
         const double th_ = sign_like ? std::tanh(omega / kEps) : 0.0;
-        const double T = p.first_moment * dp - te * z + stop_torque(theta + 0.5 * h * omega, omega);
+        const double T = alpha * dp - te * z + stop_torque(theta + 0.5 * h * omega, omega);
         // Semi-implicit in omega for the stiff tanh and the viscous term.
         const double slope = S / kEps * (1.0 - th_ * th_) + b;
         const double wn = omega + h * (T - S * th_ - b * omega) / (I + h * slope);

@@ -20,6 +20,7 @@
 #include "plant/quarter_car/quarter_car_plant.hpp"
 #include "plant/servo_valve.hpp"
 #include "rt/control/pi_controller.hpp"
+#include "tools/diagnosis/models/controller_from_record.hpp"
 #include "tools/diagnosis/rigs.hpp"
 #include "tools/diagnosis/util.hpp"
 
@@ -42,7 +43,8 @@ double tyre_contact(double f_total, double uni) {
 
 // Parameter indices (baseline, then effects in effects() order).
 enum : std::size_t {
-  kKs, kBd, kKv,                 // baseline
+  kKs, kBd, kMb, kMw, kKt, kBt,  // baseline: suspension and tyre
+  kKv, kTauR, kBetaNom, kRl, kPs, kA1, kA2, kBvr, kVd,  // baseline: valve and actuator
   kFc, kDFs, kD, kMu,            // bearing_friction
   kDc,                           // damper_asymmetry
   kTau,                          // sensor_delay
@@ -55,8 +57,9 @@ enum : std::size_t {
   kParamCount
 };
 
-constexpr std::size_t kSuspensionParams[] = {kKs, kBd, kFc, kDFs, kD, kMu, kDc, kTau, kBb, kBw, kUni};
-constexpr std::size_t kActuatorParams[] = {kKv, kUni, kSealPr, kSealPc, kLeak, kDead, kBeta};
+constexpr std::size_t kSuspensionParams[] = {kKs, kBd, kMb, kMw, kKt, kBt, kFc, kDFs, kD, kMu, kDc, kTau, kBb, kBw, kUni};
+constexpr std::size_t kActuatorParams[] = {kMb,  kMw,  kKt,  kBt,    kKv,    kTauR, kBetaNom, kRl, kPs,  kA1,
+                                           kA2,  kBvr, kVd,  kUni,   kSealPr, kSealPc, kLeak, kDead, kBeta};
 
 template <std::size_t N>
 std::vector<double> key(const std::vector<double>& th, const std::size_t (&idx)[N]) {
@@ -101,6 +104,7 @@ class QuarterCarModel : public RigModel {
       pi_ = cfg.controller.pi;
     }
     pi_.period_s = dt_;
+    controller_source_ = calibrate_pi(pi_, run.col("x_ref"), run.col("x_r"), run.col("u"));
     pi_.feedback_input = 0;
     pi_.output_index = 0;
     xref_ = run.col("x_ref");
@@ -120,9 +124,19 @@ class QuarterCarModel : public RigModel {
   const std::vector<Output>& outputs() const override { return outputs_; }
   const std::vector<double>& time() const override { return t_; }
   std::vector<ParamSpec> baseline() const override {
-    return {P("ks", "N/m", p_.spring_stiffness, 1.0, 1e7, p_.spring_stiffness),
-            P("bd", "N s/m", p_.damper_damping, 0.0, 1e6, std::max(10.0, p_.damper_damping)),
-            P("kv_scale", "1", 1.0, 0.3, 3.0, 0.1)};
+    // Every parameter a real rig is uncertain about, each with a prior of its
+    // tolerance: 5 % for masses, stiffnesses, areas, volumes, supply and bulk
+    // modulus (catalogue and drawing values); 10 % for damping, the valve's
+    // gain and time constant and the leakage (worn parts, data sheets).
+    const auto& p = p_;
+    return {Prior("ks", "N/m", p.spring_stiffness, 0.05),       Prior("bd", "N s/m", p.damper_damping, 0.10),
+            Prior("Mb", "kg", p.mass_body, 0.05),                Prior("Mw", "kg", p.mass_wheel, 0.05),
+            Prior("kt", "N/m", p.tyre_stiffness, 0.05),          Prior("bt", "N s/m", p.tyre_damping, 0.10),
+            Prior("kv_scale", "1", 1.0, 0.10),                   Prior("tau_r", "s", p.valve_time_constant, 0.10),
+            Prior("beta", "Pa", p.bulk_modulus, 0.05),           Prior("R_l", "Pa s/m^3", p.leakage_resistance, 0.10),
+            Prior("Ps", "Pa", p.supply_pressure, 0.05),          Prior("A1", "m^2", p.area_cap, 0.05),
+            Prior("A2", "m^2", p.area_rod, 0.05),                Prior("Bvr", "N s/m", p.rod_damping, 0.10),
+            Prior("V_dead", "m^3", p.dead_volume_cap, 0.05)};
   }
   std::vector<EffectSpec> effects() const override {
     return {
@@ -152,11 +166,22 @@ class QuarterCarModel : public RigModel {
          "effective bulk modulus beta_ratio x nominal (air in the oil), constant"},
     };
   }
+  // Suspension causes move only the suspension's parameters (the tyre and
+  // masses are in both); actuator causes only the actuator's; lift-off both.
+  bool couples(std::size_t index, const std::string& cause) const override {
+    static const char* kSuspensionCauses[] = {"bearing_friction", "damper_asymmetry", "sensor_delay", "sensor_offset"};
+    const bool suspension_param = index <= kBt;
+    const bool shared = index >= kMb && index <= kBt;
+    for (const char* c : kSuspensionCauses)
+      if (cause == c) return suspension_param;
+    if (cause == "tyre_liftoff") return true;
+    return !suspension_param || shared;
+  }
   std::string replay() const override {
     return "two sub-models: the actuator by closed-loop replay (x_ref through the rig's PI controller, servovalve "
            "and actuator, 5 RK4 sub-steps per period, tyre load over the measured wheel motion: outputs u, x_r, p1, "
            "p2) and the suspension by open-loop replay (measured x_r drives wheel and body, 8 sub-steps, implicit "
-           "stick-capable bearing friction: outputs x_b, x_w)";
+           "stick-capable bearing friction: outputs x_b, x_w); " + controller_source_;
   }
   // The two sub-models share only `unilateral`; a fit that moves one
   // sub-model's parameters (a column of the central differences, say) takes
@@ -218,7 +243,7 @@ class QuarterCarModel : public RigModel {
     const std::size_t n = t_.size();
     const int sub = 8;
     const double h = dt_ / sub;
-    const double mw = p_.mass_wheel, mb = p_.mass_body, kt = p_.tyre_stiffness, bt = p_.tyre_damping;
+    const double mw = th[kMw], mb = th[kMb], kt = th[kKt], bt = th[kBt];
     const double f0 = (mb + mw) * p_.gravity, weight = mb * p_.gravity;
     const bool friction = Fc > 0.0 || dFs > 0.0 || D > 0.0 || mu > 0.0;
     const BearingFrictionParams bp = p_.bearing_friction;
@@ -231,7 +256,7 @@ class QuarterCarModel : public RigModel {
       for (int s = 0; s < sub; ++s) {
         const double xr = xr0 + (xr1 - xr0) * (s + 0.5) / sub;
         const double vrel = vw - vb;
-        const double fs = ks * (xw - xb) + (bd + dc * std::tanh(vrel / 0.01)) * vrel;
+        const double fs = ks * (xw - xb) + (dc != 0.0 ? bd + dc * std::tanh(vrel / 0.01) : bd) * vrel;
         const double ft = tyre_contact(f0 + kt * (xr - xw) + bt * (vr - vw), uni) - f0;  // static part removed
         vw += h * (ft - fs) / mw;
         xw += h * vw;
@@ -262,26 +287,28 @@ class QuarterCarModel : public RigModel {
   void actuator_derivatives(const std::vector<double>& th, const Act& a, double u, double xw, double vw,
                             Act& d) const {
     const auto& p = p_;
-    d.xs = (u - a.xs) / p.valve_time_constant;
+    d.xs = (u - a.xs) / th[kTauR];
     const double delta = th[kDead];
     // Overlapped spool: the metering edge opens delta later on either side.
     const double spool = delta > 0.0 ? softplus(a.xs - delta, 0.002) - softplus(-a.xs - delta, 0.002) : a.xs;
-    const ValveFlows q = valve_flows(spool, a.p1, a.p2, p.valve_flow_gain * th[kKv], p.supply_pressure,
-                                     p.laminar_pressure);
-    const double q_leak = (p.leakage ? (a.p1 - a.p2) / p.leakage_resistance : 0.0) + th[kLeak] * (a.p1 - a.p2);
-    const double beta = p.bulk_modulus * th[kBeta];
-    const double v1 = std::max(p.dead_volume_cap + p.area_cap * (a.xr - p.stroke_min), 1e-9);
-    const double v2 = std::max(p.dead_volume_rod + p.area_rod * (p.stroke_max - a.xr), 1e-9);
-    d.p1 = beta / v1 * (q.q1 - p.area_cap * a.vr - q_leak);
-    d.p2 = beta / v2 * (p.area_rod * a.vr + q_leak - q.q2);
+    const ValveFlows q = valve_flows(spool, a.p1, a.p2, p.valve_flow_gain * th[kKv], th[kPs], p.laminar_pressure);
+    const double q_leak = (p.leakage ? (a.p1 - a.p2) / th[kRl] : 0.0) + th[kLeak] * (a.p1 - a.p2);
+    const double beta = th[kBetaNom] * th[kBeta];
+    const double a1 = th[kA1], a2 = th[kA2];
+    const double v1 = std::max(th[kVd] + a1 * (a.xr - p.stroke_min), 1e-9);
+    const double v2 = std::max(th[kVd] * p.dead_volume_rod / p.dead_volume_cap + a2 * (p.stroke_max - a.xr), 1e-9);
+    d.p1 = beta / v1 * (q.q1 - a1 * a.vr - q_leak);
+    d.p2 = beta / v2 * (a2 * a.vr + q_leak - q.q2);
     if (a.p1 <= p.cavitation_pressure && d.p1 < 0.0) d.p1 = 0.0;
     if (a.p2 <= p.cavitation_pressure && d.p2 < 0.0) d.p2 = 0.0;
-    const double f0 = (p.mass_body + p.mass_wheel) * p.gravity;
-    const double f_tyre = tyre_contact(f0 + p.tyre_stiffness * (a.xr - xw) + p.tyre_damping * (a.vr - vw), th[kUni]);
-    const double seal = (th[kSealPr] + th[kSealPc] * std::max(0.0, a.p1 + a.p2)) * std::tanh(a.vr / 0.02);
+    const double f0 = (th[kMb] + th[kMw]) * p.gravity;
+    const double f_tyre = tyre_contact(f0 + th[kKt] * (a.xr - xw) + th[kBt] * (a.vr - vw), th[kUni]);
+    // tanh (through expm1) was half the replay's time when profiled: it is
+    // computed only when the seal friction is in.
+    const double seal_level = th[kSealPr] + th[kSealPc] * std::max(0.0, a.p1 + a.p2);
+    const double seal = seal_level != 0.0 ? seal_level * std::tanh(a.vr / 0.02) : 0.0;
     d.xr = a.vr;
-    d.vr = (a.p1 * p.area_cap - a.p2 * p.area_rod - p.rod_damping * a.vr - f_tyre - p.mass_rod * p.gravity - seal) /
-           p.mass_rod;
+    d.vr = (a.p1 * a1 - a.p2 * a2 - th[kBvr] * a.vr - f_tyre - p.mass_rod * p.gravity - seal) / p.mass_rod;
   }
 
   void simulate_actuator(const std::vector<double>& th, std::vector<std::vector<double>>& y) const {
@@ -348,6 +375,7 @@ class QuarterCarModel : public RigModel {
   double dt_;
   QuarterCarParams p_;
   PiConfig pi_;
+  std::string controller_source_;
   std::vector<Output> outputs_;
   ReplayCache susp_cache_, act_cache_;
 };

@@ -1,0 +1,100 @@
+#include "tools/diagnosis/criteria.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <iomanip>
+#include <random>
+#include <sstream>
+
+namespace rigctl::diag {
+
+namespace {
+std::string fmt(double v) {
+  std::ostringstream os;
+  os << std::setprecision(3) << v;
+  return os.str();
+}
+}  // namespace
+
+double fit_percent(const std::vector<double>& y, const std::vector<double>& y_sim, std::size_t begin, std::size_t end) {
+  end = std::min({end, y.size(), y_sim.size()});
+  if (end <= begin) return 0.0;
+  double mean = 0.0;
+  for (std::size_t i = begin; i < end; ++i) mean += y[i];
+  mean /= static_cast<double>(end - begin);
+  double num = 0.0, den = 0.0;
+  for (std::size_t i = begin; i < end; ++i) {
+    num += (y[i] - y_sim[i]) * (y[i] - y_sim[i]);
+    den += (y[i] - mean) * (y[i] - mean);
+  }
+  if (den <= 0.0) return 0.0;
+  return 100.0 * (1.0 - std::sqrt(num / den));
+}
+
+double bic(double sse, std::size_t k, double n_eff, std::size_t n) {
+  return n_eff * std::log(std::max(sse, 1e-300) / static_cast<double>(std::max<std::size_t>(n, 1))) +
+         static_cast<double>(k) * std::log(n_eff);
+}
+
+std::vector<std::vector<double>> bootstrap_fits(const std::vector<double>& y,
+                                                const std::vector<const std::vector<double>*>& sims,
+                                                std::size_t begin, std::size_t end, int resamples, unsigned seed,
+                                                std::size_t blocks) {
+  // Per block: sum of squared errors of each simulation.
+  std::vector<std::vector<double>> sse(blocks, std::vector<double>(sims.size(), 0.0));
+  double sy = 0.0, sy2 = 0.0;
+  for (std::size_t k = 0; k < blocks; ++k) {
+    const std::size_t b = begin + (end - begin) * k / blocks, e = begin + (end - begin) * (k + 1) / blocks;
+    for (std::size_t i = b; i < e; ++i) {
+      sy += y[i], sy2 += y[i] * y[i];
+      for (std::size_t s = 0; s < sims.size(); ++s) {
+        const double d = y[i] - (*sims[s])[i];
+        sse[k][s] += d * d;
+      }
+    }
+  }
+  const double cnt = static_cast<double>(end - begin);
+  const double var = sy2 - sy * sy / cnt;  // fixed denominator: the held-out variance
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<std::size_t> pick(0, blocks - 1);
+  std::vector<std::vector<double>> out(static_cast<std::size_t>(resamples), std::vector<double>(sims.size(), 0.0));
+  for (auto& row : out) {
+    std::vector<double> acc(sims.size(), 0.0);
+    for (std::size_t k = 0; k < blocks; ++k) {
+      const auto& q = sse[pick(rng)];
+      for (std::size_t s = 0; s < sims.size(); ++s) acc[s] += q[s];
+    }
+    for (std::size_t s = 0; s < sims.size(); ++s) row[s] = var > 0.0 ? 100.0 * (1.0 - std::sqrt(acc[s] / var)) : 0.0;
+  }
+  return out;
+}
+
+double gain_standard_error(const std::vector<std::vector<double>>& fits, std::size_t c, std::size_t cur) {
+  if (fits.empty()) return 0.0;
+  double m1 = 0.0, m2 = 0.0;
+  for (const auto& r : fits) {
+    const double g = r[c] - r[cur];
+    m1 += g, m2 += g * g;
+  }
+  const double n = static_cast<double>(fits.size());
+  m1 /= n;
+  return std::sqrt(std::max(0.0, m2 / n - m1 * m1));
+}
+
+std::string rejection(const CandidateEvidence& c, const DiagnoseOptions& o) {
+  const double need = std::max(o.min_gain, 2.0 * c.se);
+  if (!(c.gain >= need)) return "held-out gain " + fmt(c.gain) + " pp below " + fmt(need) + " pp";
+  const bool obvious = c.gain >= o.strong_gain && c.gain >= o.strong_se * c.se;
+  if (!c.significant && !obvious)
+    return "effect strength not significant (< 3 sigma) and the gain " + fmt(c.gain) + " pp below the " +
+           fmt(std::max(o.strong_gain, o.strong_se * c.se)) + " pp that would stand on its own";
+  if (!(c.bic_new < c.bic_current)) return "BIC (with N_eff) not lower";
+  return {};
+}
+
+bool about_equal(double a, double b, const DiagnoseOptions& o) {
+  return std::abs(a - b) < std::max(o.ambiguity_margin, 0.1 * std::max(std::abs(a), std::abs(b)));
+}
+
+}  // namespace rigctl::diag
