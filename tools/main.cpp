@@ -13,6 +13,8 @@
 #include "tools/hidden_effects/make_run.hpp"
 #include "tools/bridge/bridge_command.hpp"
 #include "tools/identify/identify_command.hpp"
+#include "tools/iterate/iterate_command.hpp"
+#include "tools/iterate/road_target_command.hpp"
 #include "tools/tune/tune_command.hpp"
 #include "tools/runfile/log2csv.hpp"
 #include "tools/runfile/log2mcap.hpp"
@@ -34,6 +36,16 @@ void install_stop_handlers() {
   sigemptyset(&sa.sa_mask);
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
+}
+
+// CAUSE[:weak|strong|LEVEL] per text (make-run, iterate --effect).
+std::vector<std::pair<std::string, double>> parse_effects(const std::vector<std::string>& texts) {
+  std::vector<std::pair<std::string, double>> out;
+  for (const auto& e : texts) {
+    const auto colon = e.find(':');
+    out.emplace_back(e.substr(0, colon), colon == std::string::npos ? 1.0 : rigctl::parse_effect_level(e.substr(colon + 1)));
+  }
+  return out;
 }
 
 }  // namespace
@@ -189,6 +201,7 @@ int main(int argc, char** argv) {
   auto* res_opt = ident_cmd->add_option("--resolution", ident_resolution, "Frequency resolution [Hz]: one Welch segment lasts 1/resolution")->check(CLI::PositiveNumber);
   auto* op_opt = ident_cmd->add_option("--operating-point", ident_op, "Demand held while exciting [feedback unit] (default: mid-stroke, the middle of safety.setpoint_range)");
   auto* settle_opt = ident_cmd->add_option("--settle", ident_settle, "Hold at the operating point before the excitation [s]")->check(CLI::NonNegativeNumber);
+  ident_cmd->add_option("--response", ident.settings.extra_responses, "Also measure this response channel after the controller's feedback (e.g. x_w for rigctl iterate); repeatable");
   auto* gain_opt = ident_cmd->add_option("--stabiliser-gain", ident_gain, "Replace the controller by a proportional one of this gain (PI: kp, P+V+dP: Ke): a rig without gains")->check(CLI::PositiveNumber);
 
   rigctl::TuneOptions tune;
@@ -211,6 +224,39 @@ int main(int argc, char** argv) {
   tune_cmd->add_option("--log", tune.relay.log_path, "LCM log of the relay run");
   tune_cmd->add_flag("--fast", tune.relay.fast, "Relay on a simulated plant: simulated time");
   tune_cmd->add_flag("--no-realtime{false}", tune.relay.realtime, "Do not try mlockall/SCHED_FIFO");
+
+  // Road-simulator drive iteration (issue 19): docs/drive-iteration.md.
+  rigctl::IterateOptions iter;
+  std::vector<std::string> iter_effects;
+  auto* iter_cmd = app.add_subcommand("iterate", "Iterate the rig's drive until a channel's response matches a target (road simulator; docs/drive-iteration.md)");
+  iter_cmd->add_option("config", iter.config_path, "Rig config (YAML)")->required()->check(CLI::ExistingFile);
+  iter_cmd->add_option("--case", iter.case_name, "Apply a named variant from the config's `cases:`");
+  iter_cmd->add_option("--target", iter.target_path, "Target: a run file (t and the channel) or an RPC III file (.rsp, .tim)")->required()->check(CLI::ExistingFile);
+  iter_cmd->add_option("--channel", iter.channel, "The target channel, e.g. x_w")->required();
+  iter_cmd->add_option("--out", iter.out_dir, "Folder for summary.json and each iteration's drive and response")->required();
+  auto* frf_opt = iter_cmd->add_option("--frf", iter.frf_path, "FRF file from rigctl identify (with the channel: identify --response NAME)")->check(CLI::ExistingFile);
+  iter_cmd->add_option("--model", iter.model_path, "Diagnosis JSON (rigctl diagnose --json): the inverse from the model it extended (default: the config's nominal model)")->check(CLI::ExistingFile)->excludes(frf_opt);
+  iter_cmd->add_option("--max-iterations", iter.settings.max_iterations, "Drives played at most")->capture_default_str()->check(CLI::PositiveNumber);
+  iter_cmd->add_option("--tolerance", iter.settings.tolerance_percent, "Stop at this relative RMS error [%] over the band")->capture_default_str()->check(CLI::PositiveNumber);
+  iter_cmd->add_option("--gain", iter.settings.initial_gain, "The update's gain alpha at the start, 0..1")->capture_default_str()->check(CLI::Range(0.05, 1.0));
+  iter_cmd->add_option("--band", iter.settings.inverse.band_min_hz, "Low end of the band [Hz]")->capture_default_str();
+  iter_cmd->add_option("--band-max", iter.settings.inverse.band_max_hz, "High end of the band [Hz]")->capture_default_str();
+  iter_cmd->add_flag("--scale", iter.settings.scale_to_fit, "Scale a drive beyond the rig's limits until it fits, instead of refusing it");
+  iter_cmd->add_flag("--fast", iter.fast, "Simulated plant only: simulated time, as fast as the CPU allows");
+  iter_cmd->add_flag("--no-realtime{false}", iter.realtime, "Do not try mlockall/SCHED_FIFO");
+  iter_cmd->add_flag("--plot", iter.plot, "Also plot target, responses and errors per iteration (DIR/iterations.png; needs matplotlib)");
+  iter_cmd->add_option("--effect", iter_effects, "Simulated rig only: a hidden effect, CAUSE[:weak|strong|LEVEL] as for make-run; repeatable");
+
+  rigctl::RoadTargetOptions road;
+  std::string road_class = "C";
+  auto* road_cmd = app.add_subcommand("road-target", "A target for rigctl iterate: a quarter car's wheel displacement over an ISO 8608 road (docs/drive-iteration.md)");
+  road_cmd->add_option("config", road.config_path, "Quarter-car config: its wheel, body, tyre and mid-stroke")->required()->check(CLI::ExistingFile);
+  road_cmd->add_option("--class", road_class, "ISO 8608 road class A..E")->capture_default_str()->check(CLI::IsMember({"A", "B", "C", "D", "E"}));
+  road_cmd->add_option("--speed", road.spec.speed_m_s, "Road speed [m/s]")->capture_default_str()->check(CLI::PositiveNumber);
+  road_cmd->add_option("--duration", road.spec.duration_s, "Length [s]")->capture_default_str()->check(CLI::PositiveNumber);
+  road_cmd->add_option("--seed", road.spec.seed, "Seed of the road's random phases")->capture_default_str();
+  road_cmd->add_option("--channel", road.channel, "Column name of the wheel displacement")->capture_default_str();
+  road_cmd->add_option("--out", road.out_path, "Run file to write (CSV), or RPC III (.rsp, .tim)")->required();
 
   CLI11_PARSE(app, argc, argv);
 
@@ -239,6 +285,17 @@ int main(int argc, char** argv) {
       install_stop_handlers();
       return rigctl::run_identify(ident, g_stop, std::cout).aborted ? 3 : 0;
     }
+    if (iter_cmd->parsed()) {
+      iter.effects = parse_effects(iter_effects);
+      install_stop_handlers();
+      const auto result = rigctl::run_iterate(iter, g_stop, std::cout);
+      return result.outcome.end == rigctl::IterationEnd::kRunEnded ? 3 : 0;
+    }
+    if (road_cmd->parsed()) {
+      road.spec.road_class = rigctl::iso_road_class_from_letter(road_class);
+      rigctl::run_road_target(road, std::cout);
+      return 0;
+    }
     if (tune_cmd->parsed()) {
       tune.method = rigctl::parse_kind<rigctl::TuneMethod>(tune_method);
       if (bw_opt->count() > 0) tune.target.crossover_hz = tune_bandwidth;
@@ -265,11 +322,7 @@ int main(int argc, char** argv) {
     if (opcmd_cmd->parsed()) return rigctl::run_cmd_command(opcmd, std::cout, std::cerr);
     if (make_cmd->parsed()) {
       make.rig = rigctl::parse_kind<rigctl::RigKind>(make_rig);
-      for (const auto& e : effect_texts) {
-        const auto colon = e.find(':');
-        make.effects.emplace_back(e.substr(0, colon),
-                                  colon == std::string::npos ? 1.0 : rigctl::parse_effect_level(e.substr(colon + 1)));
-      }
+      make.effects = parse_effects(effect_texts);
       rigctl::make_run(make, std::cerr);
       return 0;
     }

@@ -1,5 +1,7 @@
 #include "tools/identify/identify_plan.hpp"
 
+#include <algorithm>
+
 #include <cmath>
 
 #include "config/config_reader.hpp"
@@ -88,6 +90,9 @@ IdentifyPlan plan_identification(RigConfig config, const IdentifySettings& s) {
   plan.settle_s = s.settle_s.value_or(ic.settle_s);
   plan.responses = {config.controller.feedback};
   if (kind == ControllerKind::kPvp) plan.responses.push_back(config.controller.pressure);
+  for (const auto& extra : s.extra_responses) {
+    if (std::find(plan.responses.begin(), plan.responses.end(), extra) == plan.responses.end()) plan.responses.push_back(extra);
+  }
   plan.config = std::move(config);
   return plan;
 }

@@ -7,6 +7,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "config/rig_config.hpp"
 #include "tools/identify/amplitude_clamp.hpp"
@@ -26,6 +27,9 @@ struct IdentifySettings {
   // The loop's controller replaced by a proportional one of this gain
   // (PI: kp = K, ki = 0; P+V+dP: Ke = K, Kv = Kp = 0): a rig with no gains yet.
   std::optional<double> stabiliser_gain;
+  // Further response channels measured after the controller's own (the drive
+  // iteration's target channel, e.g. the wheel's x_w): `--response NAME`.
+  std::vector<std::string> extra_responses;
 };
 
 struct IdentifyPlan {
@@ -35,7 +39,7 @@ struct IdentifyPlan {
   AmplitudeClamp clamp;
   ExcitationSpec excitation;   // amplitude already clamped
   double settle_s = 0.0;
-  std::vector<std::string> responses;  // the controller's feedback channels, the controlled one first
+  std::vector<std::string> responses;  // the controller's feedback channels, the controlled one first, then the extra ones
 };
 
 // Throws ConfigError for a rig whose controller is not a position loop

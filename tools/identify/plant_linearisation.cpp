@@ -67,7 +67,9 @@ int output_row(const std::string& name) {
   if (name == "x_r") return static_cast<int>(kXr);
   if (name == "p1") return static_cast<int>(kP1);
   if (name == "p2") return static_cast<int>(kP2);
-  throw std::invalid_argument("the quarter car's linearisation has no output '" + name + "' (outputs: x_r, p1, p2)");
+  if (name == "x_w") return static_cast<int>(kXw);  // the drive iteration's wheel-displacement target
+  if (name == "x_b") return static_cast<int>(kXb);
+  throw std::invalid_argument("the quarter car's linearisation has no output '" + name + "' (outputs: x_r, x_w, x_b, p1, p2)");
 }
 
 }  // namespace

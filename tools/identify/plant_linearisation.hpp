@@ -24,7 +24,7 @@ struct LinearPlant {
 };
 
 // The quarter car about the rod at x_r [m] (the body's bearing held, as it
-// is under small motion). Outputs by run-file name: x_r, p1, p2.
+// is under small motion). Outputs by run-file name: x_r, x_w, x_b, p1, p2.
 LinearPlant linearise_quarter_car(const QuarterCarParams& params, double x_r, const std::vector<std::string>& outputs);
 
 // The rig's plant linearised at `operating_point` for the given responses;

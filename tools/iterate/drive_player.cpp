@@ -1,0 +1,63 @@
+#include "tools/iterate/drive_player.hpp"
+
+#include <sstream>
+
+#include "tools/identify/excitation_profile.hpp"
+#include "tools/identify/identify_analysis.hpp"
+#include "tools/run/rig_assembly.hpp"
+#include "tools/run/run_command.hpp"
+#include "tools/runfile/run_file.hpp"
+
+namespace rigctl {
+
+namespace {
+
+// Held at the operating point after the drive, so that the run's controlled
+// stop never cuts into the record.
+constexpr double kTailS = 0.5;
+
+}  // namespace
+
+PlayResult play_drive(const RigConfig& config, const std::vector<double>& drive, const std::string& channel,
+                      const PlaySettings& s, const std::atomic<bool>& stop, std::ostream& out) {
+  std::vector<double> deviation(drive.size());
+  for (std::size_t i = 0; i < drive.size(); ++i) deviation[i] = drive[i] - s.operating_point;
+  LeadIn lead;
+  lead.start = config.profile.start;
+  lead.target = s.operating_point;
+  lead.hold_s = config.profile.hold_s;
+  lead.rate = config.profile.ramp_rate > 0.0 ? config.profile.ramp_rate : config.safety.setpoint_rate;
+
+  RunOptions ro;
+  ro.config_path = config.file;
+  ro.case_name = config.case_name;
+  ro.fast = s.fast;
+  ro.realtime = s.realtime;
+  ro.csv_path = s.csv_path;
+  ro.log_path = s.log_path;
+  ro.profile_override = [&] {
+    return std::make_unique<ExcitationProfile>(lead, s.settle_s, deviation, config.loop.period_s, kTailS);
+  };
+  std::ostringstream run_out;  // the run's own report: the iteration reports per iteration instead
+  const RunReport report = run_rig(config, ro, stop, run_out);
+  PlayResult r;
+  if (report.loop.final_state == RigState::kFaulted || stop.load()) {
+    r.end_reason = stop.load() ? "stop requested" : report.end_reason;
+    out << run_out.str();
+    return r;
+  }
+  const std::string setpoint = setpoint_name_for(config.rig);
+  RunFileOptions columns;
+  columns.required = {setpoint, channel};
+  const RunFile run = read_run_file(s.csv_path, columns);
+  const auto settle_ticks = static_cast<std::size_t>(s.settle_s / run.dt);
+  const std::size_t start = find_excitation_start(run.col(setpoint), s.operating_point, deviation, settle_ticks);
+  const auto& y = run.col(channel);
+  r.response.assign(y.begin() + static_cast<std::ptrdiff_t>(start),
+                    y.begin() + static_cast<std::ptrdiff_t>(start + drive.size()));
+  r.drive_start_s = run.t[start];
+  r.completed = true;
+  return r;
+}
+
+}  // namespace rigctl

@@ -1,0 +1,34 @@
+#include "tools/iterate/match_metrics.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "tools/iterate/spectrum.hpp"
+
+namespace rigctl {
+
+MatchMetrics match_metrics(const std::vector<double>& target, const std::vector<double>& response, double period_s,
+                           double band_min_hz, double band_max_hz) {
+  if (target.size() != response.size() || target.empty()) {
+    throw std::invalid_argument("match metrics: target and response differ in length");
+  }
+  const auto t = band_limited(target, period_s, band_min_hz, band_max_hz);
+  const auto r = band_limited(response, period_s, band_min_hz, band_max_hz);
+  double tt = 0.0, rr = 0.0, tr = 0.0, ee = 0.0;
+  MatchMetrics m;
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    const double e = r[i] - t[i];
+    tt += t[i] * t[i];
+    rr += r[i] * r[i];
+    tr += t[i] * r[i];
+    ee += e * e;
+    m.peak_error = std::max(m.peak_error, std::abs(e));
+  }
+  if (tt <= 0.0) throw std::invalid_argument("match metrics: the target has no content in the band");
+  m.rel_rms_percent = 100.0 * std::sqrt(ee / tt);
+  m.trac = rr > 0.0 ? tr * tr / (tt * rr) : 0.0;
+  m.rms_error = std::sqrt(ee / static_cast<double>(t.size()));
+  return m;
+}
+
+}  // namespace rigctl

@@ -1,0 +1,23 @@
+// How well a response matches its target, on the band the iteration works
+// in (both records band-limited first, so drift below the band and noise
+// above it do not count): relative RMS error, TRAC (the time-response
+// assurance criterion, the squared correlation: 1 for the same shape) and
+// the peak error.
+#pragma once
+
+#include <vector>
+
+namespace rigctl {
+
+struct MatchMetrics {
+  double rel_rms_percent = 0.0;  // 100 rms(e) / rms(target)
+  double trac = 0.0;             // (t . r)^2 / ((t . t)(r . r)), 0..1
+  double peak_error = 0.0;       // max |e| [target unit]
+  double rms_error = 0.0;        // [target unit]
+};
+
+// target and response of equal length at period_s.
+MatchMetrics match_metrics(const std::vector<double>& target, const std::vector<double>& response, double period_s,
+                           double band_min_hz, double band_max_hz);
+
+}  // namespace rigctl
