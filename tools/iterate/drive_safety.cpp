@@ -87,27 +87,31 @@ DrivePeaks drive_peaks(const RigConfig& c, const std::vector<double>& d, double 
 }
 
 DriveVerdict check_drive(const DrivePeaks& k, const DriveLimits& l, double op) {
+  // Every limit's room as a factor on the drive's swing about the operating
+  // point; the one with the least room is the limit that stops the drive.
   DriveVerdict v;
+  v.fit_scale = std::numeric_limits<double>::infinity();
   auto take = [&](double scale, const std::string& why) {
-    if (scale < 1.0 && v.ok) {
+    if (scale >= v.fit_scale) return;
+    v.fit_scale = scale;
+    if (scale < 1.0) {
       v.ok = false;
       v.reason = why;
     }
-    v.fit_scale = std::min(v.fit_scale, scale);
   };
-  if (k.max > l.position_max) {
+  if (k.max > op) {
     take((l.position_max - op) / (k.max - op),
-         "stroke: the drive reaches " + fmt(k.max) + " above " + l.position_source + " max " + fmt(l.position_max));
+         "stroke: the drive reaches " + fmt(k.max) + ", above " + l.position_source + " max " + fmt(l.position_max));
   }
-  if (k.min < l.position_min) {
+  if (k.min < op) {
     take((op - l.position_min) / (op - k.min),
-         "stroke: the drive reaches " + fmt(k.min) + " below " + l.position_source + " min " + fmt(l.position_min));
+         "stroke: the drive reaches " + fmt(k.min) + ", below " + l.position_source + " min " + fmt(l.position_min));
   }
-  if (k.velocity > l.velocity_max) {
+  if (k.velocity > 0.0) {
     take(l.velocity_max / k.velocity,
          "velocity: the drive moves at " + fmt(k.velocity) + " beyond " + l.velocity_source + " " + fmt(l.velocity_max));
   }
-  if (k.valve_effort > l.effort_max) {
+  if (k.valve_effort > 0.0) {
     // The effort is proportional to the velocity (the hold aside): scale alike.
     take(l.effort_max / k.valve_effort, "flow: the drive needs a valve effort of " + fmt(k.valve_effort) +
                                             " beyond " + l.effort_source + " " + fmt(l.effort_max));

@@ -32,8 +32,8 @@ struct DrivePeaks {
 
 struct DriveVerdict {
   bool ok = true;
-  std::string reason;  // the first limit exceeded, with the numbers
-  double fit_scale = 1.0;  // the largest factor on (drive - operating point) that fits every limit
+  std::string reason;  // the limit exceeded with the least room (the one that stops the drive), with the numbers
+  double fit_scale = 1.0;  // the largest factor on (drive - operating point) that fits every limit (> 1: room to spare)
 };
 
 DriveLimits drive_limits(const RigConfig& config);
