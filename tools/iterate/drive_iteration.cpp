@@ -44,10 +44,23 @@ struct Step {
       out.end_detail = "drive " + std::to_string(rec.index) + " not played: " + v.reason;
       return false;
     }
-    // Scale a little below the fit so the rounding of the peaks cannot tip it over.
-    rec.drive_scale = 0.99 * v.fit_scale;
-    scale_drive(drive, rig.operating_point, rec.drive_scale);
-    rec.peaks = drive_peaks(*rig.config, drive, rig.operating_point, rig.command_hold);
+    // Scale a little below the fit so the rounding of the peaks cannot tip
+    // it over; again while the valve's hold command (which does not scale)
+    // keeps the effort above its limit.
+    rec.limited_by = v.reason;
+    DriveVerdict now = v;
+    for (int attempt = 0; attempt < 10 && !now.ok; ++attempt) {
+      const double scale = 0.99 * now.fit_scale;
+      rec.drive_scale *= scale;
+      scale_drive(drive, rig.operating_point, scale);
+      rec.peaks = drive_peaks(*rig.config, drive, rig.operating_point, rig.command_hold);
+      now = check_drive(rec.peaks, limits, rig.operating_point);
+    }
+    if (!now.ok) {
+      out.end = IterationEnd::kDriveLimit;
+      out.end_detail = "drive " + std::to_string(rec.index) + " cannot be scaled to fit: " + now.reason;
+      return false;
+    }
     return true;
   }
 };
@@ -95,6 +108,7 @@ IterationOutcome iterate_drive(const std::vector<double>& target, const DriveFrf
     if (out.iterations.size() > 1 && err >= out.iterations[out.best].match.rel_rms_percent) {
       out.end = IterationEnd::kNoImprovement;
       out.end_detail = "iteration " + std::to_string(k) + " did not lower the error";
+      if (!rec.limited_by.empty()) out.end_detail += "; its drive was scaled by " + std::to_string(rec.drive_scale) + " for " + rec.limited_by;
       return out;
     }
     out.best = out.iterations.size() - 1;
@@ -112,6 +126,9 @@ IterationOutcome iterate_drive(const std::vector<double>& target, const DriveFrf
     for (std::size_t i = 0; i < drive.size(); ++i) drive[i] += update[i];
   }
   out.end = IterationEnd::kMaxIterations;
+  if (!out.iterations.empty() && !out.iterations.back().limited_by.empty()) {
+    out.end_detail = "the last drive was scaled for " + out.iterations.back().limited_by;
+  }
   return out;
 }
 

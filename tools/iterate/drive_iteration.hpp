@@ -48,6 +48,7 @@ struct IterationRecord {
   MatchMetrics match;
   DrivePeaks peaks;
   double drive_scale = 1.0;   // < 1: scaled to fit the limits
+  std::string limited_by;     // then the limit it was scaled for
   std::vector<double> gain;   // alpha per gain band the drive was made with
 };
 

@@ -41,7 +41,10 @@ PlayResult play_drive(const RigConfig& config, const std::vector<double>& drive,
   std::ostringstream run_out;  // the run's own report: the iteration reports per iteration instead
   const RunReport report = run_rig(config, ro, stop, run_out);
   PlayResult r;
-  if (report.loop.final_state == RigState::kFaulted || stop.load()) {
+  // Only a run that played its whole demand ends on the profile's end; any
+  // other end (a trip, a detector's controlled stop, a stop request) leaves
+  // an incomplete record.
+  if (report.loop.end_event.code != EventCode::kProfileFinished || stop.load()) {
     r.end_reason = stop.load() ? "stop requested" : report.end_reason;
     out << run_out.str();
     return r;

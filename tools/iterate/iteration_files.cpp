@@ -40,7 +40,7 @@ std::string iteration_json(const IterationRecord& r, const std::string& dir_hint
     << ", \"max\": " << json_number(r.peaks.max) << ", \"peak_displacement\": " << json_number(r.peaks.displacement)
     << ", \"peak_velocity\": " << json_number(r.peaks.velocity)
     << ", \"peak_valve_effort\": " << json_number(r.peaks.valve_effort)
-    << ", \"scale\": " << json_number(r.drive_scale) << "},\n     \"gain\": " << numbers(r.gain)
+    << ", \"scale\": " << json_number(r.drive_scale) << ", \"limited_by\": " << json_string(r.limited_by) << "},\n     \"gain\": " << numbers(r.gain)
     << ",\n     \"drive_file\": " << json_string(iteration_file(dir_hint, r.index, "drive"))
     << ", \"response_file\": " << json_string(iteration_file(dir_hint, r.index, "response")) << "}";
   return o.str();
