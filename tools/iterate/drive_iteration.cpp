@@ -26,10 +26,17 @@ struct Step {
   const IterationSettings& settings;
   std::size_t fade;
 
-  // op + fade(alpha H^-1 (x)): a correction that starts and ends at rest.
+  // alpha H^-1 x, its moving part faded in and out so that the drive starts
+  // and ends at rest; its mean is kept (the rest level moves with it: the
+  // wheel's static offset from the rod, the tyre's deflection, is corrected
+  // at the ends too).
   std::vector<double> correction(const std::vector<double>& x, const std::vector<double>& gain) const {
     std::vector<double> c = inverse.apply(x, gain);
+    double mean = 0.0;
+    for (double v : c) mean += v / static_cast<double>(c.size());
+    for (double& v : c) v -= mean;
     fade_ends(c, fade);
+    for (double& v : c) v += mean;
     return c;
   }
 

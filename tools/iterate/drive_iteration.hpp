@@ -37,7 +37,7 @@ struct IterationSettings {
   double initial_gain = 0.9;
   double gain_cut = 0.5;        // alpha x this in a band where the error grew
   bool scale_to_fit = false;    // scale a drive beyond the limits instead of refusing it
-  double fade_s = 1.0;          // [s] the drive's corrections fade in and out at the ends
+  double fade_s = 0.25;         // [s] the corrections fade in and out at the ends: the drive starts and ends at rest
   InverseSettings inverse;
 };
 

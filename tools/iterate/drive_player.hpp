@@ -17,8 +17,8 @@
 namespace rigctl {
 
 struct PlaySettings {
-  double operating_point = 0.0;  // [feedback unit] the drive's rest level
-  double settle_s = 2.0;         // [s] held there before the drive
+  double operating_point = 0.0;  // [feedback unit] the drive's rest level (its first and last value)
+  double settle_s = 5.0;         // [s] held there before the drive: the PI integrator takes up the leakage (~1 s) and the body settles on its bearing
   bool fast = false;             // simulated rigs: simulated time
   bool realtime = true;
   std::string csv_path;          // the run's run file (kept: the iteration's record)

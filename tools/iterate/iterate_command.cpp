@@ -106,6 +106,7 @@ IterateResult run_iterate(const IterateOptions& o, const std::atomic<bool>& stop
   // From the config as given: a rig's hidden effects are not known to the one who runs it.
   iteration_rig.command_hold = command_hold(nominal, op);
   iteration_rig.play = [&](const std::vector<double>& drive, int k) {
+    play.operating_point = drive.front();  // the drive's rest level: the lead-in goes there
     play.csv_path = o.out_dir + "/iter_" + (k < 10 ? "0" : "") + std::to_string(k) + "_run.csv";
     play.log_path = o.out_dir + "/iter_" + (k < 10 ? "0" : "") + std::to_string(k) + "_run.lcm";
     return play_drive(rig, drive, o.channel, play, stop, out);
