@@ -125,6 +125,19 @@ TEST(DriveIteration, MeasuredFrfInverseReachesFivePercentWithinSixIterations) {
   expect_converged_within_six(s, r.output);
 }
 
+TEST(DriveIteration, DiagnosisModelInverseReachesFivePercentWithinSixIterations) {
+  const std::string dir = fresh_dir("diagnosis");
+  const std::string target = road_target(dir);
+  // The diagnosis of this very rig (tests/data/README.md says how it was made).
+  const std::string diagnosis = std::string(RIGCTL_TEST_DATA) + "/quarter_car_worn_seal_diagnosis.json";
+  const auto r = rigctl("iterate " + kConfig + " --target " + target + " --channel x_w --model " + diagnosis + " --out " +
+                        dir + "/out --fast --no-realtime --effect cross_port_leakage");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto s = summary_of(dir + "/out");
+  EXPECT_EQ(s["frf_source"], "diagnosis model " + diagnosis);
+  expect_converged_within_six(s, r.output);
+}
+
 TEST(DriveIteration, AnFrfWithoutTheChannelSaysHowToMeasureIt) {
   const std::string dir = fresh_dir("no-channel");
   const auto id = rigctl("identify " + kConfig + " --out " + dir + "/frf.json --fast --no-realtime --log " + dir + "/i.lcm");
