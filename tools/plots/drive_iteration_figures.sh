@@ -28,6 +28,8 @@ else
   "$rigctl" diagnose --rig quarter_car --data "$work/diagnosis-run.csv" --config "$config" --json "$work/diagnosis.json" --quiet \
     | grep -E "^cause|fit"
 fi
+# Measured on the config's rig: identify has no hidden effects, so this FRF
+# is the rig before its piston seal wore (an FRF older than the rig's state).
 "$rigctl" identify "$config" --fast --no-realtime --response x_w --out "$work/frf.json" --log "$work/identify.lcm" \
   | grep -E "FRF|x_w"
 
@@ -37,7 +39,7 @@ for road in "C 2" "D 1"; do
   "$rigctl" road-target "$config" --class "$1" --speed "$2" --duration 20 --out "$work/$name.csv"
   for inverse in nominal: diagnosis:"--model $work/diagnosis.json" measured:"--frf $work/frf.json"; do
     label=${inverse%%:*}
-    echo "== ISO 8608 class $1 at $2 m/s, inverse from the $label model/FRF"
+    echo "== ISO 8608 class $1 at $2 m/s, inverse from: $label"
     # shellcheck disable=SC2086
     "$rigctl" iterate "$config" --target "$work/$name.csv" --channel x_w --out "$work/$name-$label" "${rig[@]}" \
       --tolerance 1 --max-iterations 8 ${inverse#*:} --plot | grep -E "iteration [0-9]|end:"

@@ -65,7 +65,8 @@ def main():
     if len(runs) > 1:
         ax[0].plot(t[sel], 1e3 * runs[-1][ch][sel], "--", lw=1, label=f"iteration {its[-1]['iteration']}")
     ax[0].set_ylabel(f"{ch} [mm]")
-    ax[0].set_title(f"{ch}: target and response ({summary['frf_source']})")
+    source = " ".join(os.path.basename(w) if "/" in w else w for w in summary["frf_source"].split(" "))
+    ax[0].set_title(f"{ch}: target and response (inverse from {source})")
     ax[0].legend(loc="upper right")
     for i, r in zip(its, runs):
         ax[1].plot(t, 1e3 * (r[ch] - r["target"]), lw=0.8,
