@@ -4,6 +4,11 @@
 
 namespace rigctl {
 
+LeadIn lead_in_to(const RigConfig& config, double operating_point) {
+  const ProfileConfig& p = config.profile;
+  return LeadIn{p.start, operating_point, p.hold_s, p.ramp_rate > 0.0 ? p.ramp_rate : config.safety.setpoint_rate};
+}
+
 ExcitationProfile::ExcitationProfile(LeadIn lead_in, double settle_s, std::vector<double> excitation,
                                      double period_s, double tail_s)
     : lead_in_(lead_in), settle_s_(settle_s), excitation_(std::move(excitation)), period_s_(period_s),

@@ -6,9 +6,15 @@
 
 #include <vector>
 
+#include "config/rig_config.hpp"
 #include "rt/control/setpoint_profile.hpp"
 
 namespace rigctl {
+
+// The config's lead-in to `operating_point` (from where the rig stands with
+// `start: measured`): its own approach to its test position, else the
+// held-setpoint rate. Identification and the drive iteration share it.
+LeadIn lead_in_to(const RigConfig& config, double operating_point);
 
 class ExcitationProfile final : public SetpointProfile {
  public:

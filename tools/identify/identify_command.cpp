@@ -30,14 +30,8 @@ std::string default_csv_path(const std::string& out_path) {
 }
 
 std::unique_ptr<SetpointProfile> excitation_profile(const IdentifyPlan& plan, const Excitation& e) {
-  const ProfileConfig& p = plan.config.profile;
-  LeadIn lead;
-  lead.start = p.start;
-  lead.target = plan.operating_point;
-  lead.hold_s = p.hold_s;
-  // The config's own approach to its test position, else the held-setpoint rate.
-  lead.rate = p.ramp_rate > 0.0 ? p.ramp_rate : plan.config.safety.setpoint_rate;
-  return std::make_unique<ExcitationProfile>(lead, plan.settle_s, e.values, plan.config.loop.period_s, kTailS);
+  return std::make_unique<ExcitationProfile>(lead_in_to(plan.config, plan.operating_point), plan.settle_s, e.values,
+                                             plan.config.loop.period_s, kTailS);
 }
 
 void describe_plan(const IdentifyPlan& plan, std::ostream& out) {

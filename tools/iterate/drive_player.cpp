@@ -22,11 +22,7 @@ PlayResult play_drive(const RigConfig& config, const std::vector<double>& drive,
                       const PlaySettings& s, const std::atomic<bool>& stop, std::ostream& out) {
   std::vector<double> deviation(drive.size());
   for (std::size_t i = 0; i < drive.size(); ++i) deviation[i] = drive[i] - s.operating_point;
-  LeadIn lead;
-  lead.start = config.profile.start;
-  lead.target = s.operating_point;
-  lead.hold_s = config.profile.hold_s;
-  lead.rate = config.profile.ramp_rate > 0.0 ? config.profile.ramp_rate : config.safety.setpoint_rate;
+  const LeadIn lead = lead_in_to(config, s.operating_point);
 
   RunOptions ro;
   ro.config_path = config.file;

@@ -79,10 +79,6 @@ LoopGains ziegler_nichols(LoopGains g, double ku, double tu) {
 
 namespace {
 
-LeadIn lead_in_to(const RigConfig& c, double op) {
-  return LeadIn{c.profile.start, op, c.profile.hold_s, c.profile.ramp_rate > 0.0 ? c.profile.ramp_rate : c.safety.setpoint_rate};
-}
-
 RelaySettings relay_settings(const RigConfig& c, const RelayOptions& ro, double stabiliser_gain, double op) {
   const LoopGains base = LoopGains::from_config(c);
   RelaySettings s;
