@@ -68,6 +68,21 @@ void plot_iterations(const std::string& dir) {
   }
 }
 
+IterationSummary summary_of(const IterateOptions& o, const RigConfig& rig, const DriveFrf& frf, double op) {
+  IterationSummary summary;
+  summary.config = o.config_path;
+  summary.target = o.target_path;
+  summary.channel = o.channel;
+  summary.frf_source = frf.source;
+  summary.rig = std::string(to_string(rig.rig));
+  summary.operating_point = op;
+  summary.band_min_hz = o.settings.inverse.band_min_hz;
+  summary.band_max_hz = o.settings.inverse.band_max_hz;
+  summary.tolerance_percent = o.settings.tolerance_percent;
+  summary.limits = drive_limits(rig);
+  return summary;
+}
+
 }  // namespace
 
 IterateResult run_iterate(const IterateOptions& o, const std::atomic<bool>& stop, std::ostream& out) {
@@ -81,17 +96,7 @@ IterateResult run_iterate(const IterateOptions& o, const std::atomic<bool>& stop
   const DriveFrf frf = drive_frf(o, nominal, op, s.inverse.band_max_hz);
   std::filesystem::create_directories(o.out_dir);
 
-  IterationSummary summary;
-  summary.config = o.config_path;
-  summary.target = o.target_path;
-  summary.channel = o.channel;
-  summary.frf_source = frf.source;
-  summary.rig = std::string(to_string(rig.rig));
-  summary.operating_point = op;
-  summary.band_min_hz = s.inverse.band_min_hz;
-  summary.band_max_hz = s.inverse.band_max_hz;
-  summary.tolerance_percent = s.tolerance_percent;
-  summary.limits = drive_limits(rig);
+  IterationSummary summary = summary_of(o, rig, frf, op);
   out << "rigctl iterate: " << o.channel << " of " << o.target_path << " (" << target.size() << " samples, "
       << static_cast<double>(target.size()) * dt << " s) about " << op << ", inverse from " << frf.source << "\n";
 
