@@ -15,6 +15,7 @@
 #include <numbers>
 
 #include "process.hpp"
+#include "tools/iterate/rpc3_file.hpp"
 #include "tools/runfile/run_file.hpp"
 
 namespace rigctl {
@@ -139,6 +140,38 @@ TEST(DriveIteration, MeasuredFrfInverseReachesFivePercentWithinSixIterations) {
   const auto s = iterate_road(dir, "--frf " + dir + "/frf.json", output);  // the rig identify measured
   EXPECT_EQ(s["frf_source"], "frf " + dir + "/frf.json");
   expect_converged_within_six(s, output);
+}
+
+TEST(DriveIteration, RpcThroughoutTargetInDrivesAndResponsesOut) {
+  const std::string dir = fresh_dir("rpc");
+  const auto made = rigctl("road-target " + kConfig + " --class C --speed 2 --duration 20 --out " + dir + "/road.rsp");
+  ASSERT_EQ(made.exit_code, 0) << made.output;
+  const auto r = rigctl("iterate " + kConfig + " --target " + dir + "/road.rsp --channel x_w --out " + dir +
+                        "/out --fast --no-realtime --max-iterations 2 --tolerance 1");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto s = summary_of(dir + "/out");
+  ASSERT_EQ(s["iterations"].size(), 2u) << r.output;
+  // The RPC III drive and response of each iteration hold what its run files hold.
+  const Rpc3File drive = read_rpc3_file(dir + "/out/iter_02_drive.drv");
+  const Rpc3File response = read_rpc3_file(dir + "/out/iter_02_response.rsp");
+  EXPECT_EQ(drive.time_type, "DRIVE");
+  EXPECT_EQ(response.time_type, "RESPONSE");
+  EXPECT_NEAR(drive.period_s, 0.0025, 1e-12);
+  RunFileOptions drive_columns;
+  drive_columns.required = {"x_ref"};
+  const RunFile csv_drive = read_run_file(dir + "/out/iter_02_drive.csv", drive_columns);
+  RunFileOptions response_columns;
+  response_columns.required = {"x_w", "target"};
+  const RunFile csv_response = read_run_file(dir + "/out/iter_02_response.csv", response_columns);
+  const auto& d = drive.channel("x_ref", "drv");
+  const auto& y = response.channel("x_w", "rsp");
+  const auto& target = response.channel("target", "rsp");
+  ASSERT_GE(d.size(), csv_drive.size());
+  for (std::size_t i = 0; i < csv_drive.size(); ++i) {
+    ASSERT_NEAR(d[i], csv_drive.col("x_ref")[i], 0.1 / 32752 + 1e-9) << i;  // half a count of a 0.1 m peak at most
+    ASSERT_NEAR(y[i], csv_response.col("x_w")[i], 0.1 / 32752 + 1e-9) << i;
+    ASSERT_NEAR(target[i], csv_response.col("target")[i], 0.1 / 32752 + 1e-9) << i;
+  }
 }
 
 TEST(DriveIteration, AnFrfWithoutTheChannelSaysHowToMeasureIt) {

@@ -67,7 +67,9 @@ void describe_frf(const FrfData& f, std::ostream& out) {
   }
 }
 
-std::vector<FrfChannel> channels_of(const RigConfig& c, const std::vector<std::string>& names) {
+}  // namespace
+
+std::vector<FrfChannel> frf_channels(const RigConfig& c, const std::vector<std::string>& names) {
   const auto plant = make_plant(c);
   std::vector<FrfChannel> out;
   for (const auto& n : names) {
@@ -82,8 +84,6 @@ std::vector<FrfChannel> channels_of(const RigConfig& c, const std::vector<std::s
   }
   return out;
 }
-
-}  // namespace
 
 IdentifyResult run_identify(const IdentifyOptions& o, const std::atomic<bool>& stop, std::ostream& out) {
   IdentifyResult result;
@@ -109,9 +109,9 @@ IdentifyResult run_identify(const IdentifyOptions& o, const std::atomic<bool>& s
   }
 
   const std::string setpoint = setpoint_name_for(plan.config.rig);
-  const auto demand = FrfChannel{setpoint, channels_of(plan.config, {plan.config.controller.feedback})[0].unit};
-  const auto command = channels_of(plan.config, {plan.config.controller.output})[0];
-  const auto responses = channels_of(plan.config, plan.responses);
+  const auto demand = FrfChannel{setpoint, frf_channels(plan.config, {plan.config.controller.feedback})[0].unit};
+  const auto command = frf_channels(plan.config, {plan.config.controller.output})[0];
+  const auto responses = frf_channels(plan.config, plan.responses);
   RunFileOptions columns;
   columns.required = {setpoint, command.name};
   columns.required.insert(columns.required.end(), plan.responses.begin(), plan.responses.end());

@@ -7,6 +7,7 @@
 #include <atomic>
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include "tools/identify/frf_data.hpp"
 #include "tools/identify/identify_plan.hpp"
@@ -33,6 +34,10 @@ struct IdentifyResult {
   FrfData frf;
   RunReport run;
 };
+
+// The rig's channels by run-file name with their SI units (the plant's
+// signals and commands); an unknown name gets an empty unit.
+std::vector<FrfChannel> frf_channels(const RigConfig& config, const std::vector<std::string>& names);
 
 // Throws ConfigError for a bad config or settings, std::runtime_error for a
 // run or record that cannot be analysed.

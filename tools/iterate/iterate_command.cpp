@@ -9,6 +9,7 @@
 #include "config/config_reader.hpp"
 #include "tools/hidden_effects/make_run.hpp"
 #include "tools/identify/frf_file.hpp"
+#include "tools/identify/identify_command.hpp"
 #include "tools/identify/identify_plan.hpp"
 #include "tools/identify/plant_linearisation.hpp"
 #include "tools/iterate/diagnosis_model.hpp"
@@ -105,6 +106,7 @@ IterateResult run_iterate(const IterateOptions& o, const std::atomic<bool>& stop
   play.fast = o.fast;
   play.realtime = o.realtime;
   const std::string setpoint = setpoint_name_for(rig.rig);
+  const std::string frf_unit = frf_channels(rig, {o.channel})[0].unit;
   IterationRig iteration_rig;
   iteration_rig.config = &rig;
   iteration_rig.operating_point = op;
@@ -119,6 +121,7 @@ IterateResult run_iterate(const IterateOptions& o, const std::atomic<bool>& stop
   iteration_rig.on_iteration = [&](const IterationRecord& r) {
     write_drive_file(iteration_file(o.out_dir, r.index, "drive"), setpoint, r.drive, dt, summary.rig);
     write_response_file(iteration_file(o.out_dir, r.index, "response"), o.channel, r.response, target, dt, summary.rig);
+    write_iteration_rpc3(o.out_dir, r.index, setpoint, o.channel, frf_unit, r, target, dt);
     report(r, out);
   };
   IterateResult result;

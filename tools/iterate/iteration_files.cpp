@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "tools/common/json_text.hpp"
+#include "tools/iterate/rpc3_file.hpp"
 
 namespace rigctl {
 
@@ -62,6 +63,23 @@ void write_drive_file(const std::string& path, const std::string& setpoint, cons
 void write_response_file(const std::string& path, const std::string& channel, const std::vector<double>& response,
                          const std::vector<double>& target, double period_s, const std::string& rig) {
   write_columns(path, rig, channel + ",target", {&response, &target}, period_s);
+}
+
+void write_iteration_rpc3(const std::string& dir, int index, const std::string& setpoint, const std::string& channel,
+                          const std::string& unit, const IterationRecord& r, const std::vector<double>& target,
+                          double period_s) {
+  const std::string base = iteration_file(dir, index, "");
+  const std::string stem = base.substr(0, base.size() - 4);  // ".../iter_NN_"
+  Rpc3File drive;
+  drive.time_type = "DRIVE";
+  drive.period_s = period_s;
+  drive.channels = {{setpoint, unit, r.drive}};
+  write_rpc3_file(drive, stem + "drive.drv");
+  Rpc3File response;
+  response.time_type = "RESPONSE";
+  response.period_s = period_s;
+  response.channels = {{channel, unit, r.response}, {"target", unit, target}};
+  write_rpc3_file(response, stem + "response.rsp");
 }
 
 std::string summary_json(const IterationSummary& s, const IterationOutcome& out) {

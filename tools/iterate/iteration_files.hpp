@@ -1,6 +1,7 @@
 // What `rigctl iterate` leaves in its output folder (docs/drive-iteration.md):
 // per iteration the drive and the recorded response as run files
-// (`iter_NN_drive.csv`, `iter_NN_response.csv`), and `summary.json` with
+// (`iter_NN_drive.csv`, `iter_NN_response.csv`) and as RPC III files
+// (`iter_NN_drive.drv`, `iter_NN_response.rsp`), and `summary.json` with
 // every iteration's numbers and why the iteration ended.
 #pragma once
 
@@ -29,6 +30,12 @@ void write_drive_file(const std::string& path, const std::string& setpoint, cons
                       double period_s, const std::string& rig);
 void write_response_file(const std::string& path, const std::string& channel, const std::vector<double>& response,
                          const std::vector<double>& target, double period_s, const std::string& rig);
+
+// The same as RPC III time histories, what road-simulator tools exchange:
+// `iter_NN_drive.drv` (the drive) and `iter_NN_response.rsp` (the channel and the target).
+void write_iteration_rpc3(const std::string& dir, int index, const std::string& setpoint, const std::string& channel,
+                          const std::string& unit, const IterationRecord& record, const std::vector<double>& target,
+                          double period_s);
 
 std::string summary_json(const IterationSummary& summary, const IterationOutcome& outcome);
 void write_text_file(const std::string& path, const std::string& text);
