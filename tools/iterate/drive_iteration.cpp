@@ -20,7 +20,6 @@ std::string_view to_string(IterationEnd end) {
 namespace {
 
 struct Step {
-  const std::vector<double>& target;
   const DriveInverse& inverse;
   const IterationRig& rig;
   const IterationSettings& settings;
@@ -84,7 +83,7 @@ IterationOutcome iterate_drive(const std::vector<double>& target, const DriveFrf
                                const IterationSettings& s) {
   const double dt = rig.config->loop.period_s;
   const DriveInverse inverse(frf, target.size(), dt, s.inverse);
-  const Step step{target, inverse, rig, s, static_cast<std::size_t>(std::llround(s.fade_s / dt))};
+  const Step step{inverse, rig, s, static_cast<std::size_t>(std::llround(s.fade_s / dt))};
   std::vector<double> gain(inverse.bands().size(), 1.0);
   std::vector<double> rest(target.size(), rig.operating_point);
   // First drive: the inverse applied to the target (its deviation from the rest level).
