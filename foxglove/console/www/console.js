@@ -29,11 +29,12 @@
     return page.units.get(channel.id);
   }
 
-  function unitFor(name, units) {
-    const scopeList = (page.station && page.station.scope) || [];
-    // The setpoint's unit is the feedback's (the command message does not carry it).
-    if (!units[name] && scopeList[0] === name && scopeList.length > 1) return "demand";
-    if (scopeList.length > 1 && name === scopeList[1]) return "demand";
+  // The strip a channel goes in: the setpoint and its feedback share one
+  // (the command message does not carry the setpoint's unit), the others
+  // one per unit.
+  function groupFor(name, units) {
+    const scopeList = ((page.station && page.station.scope) || []).filter((n) => n);
+    if (scopeList.length > 1 && (name === scopeList[0] || name === scopeList[1])) return "demand";
     return units[name] || "";
   }
 
@@ -56,7 +57,7 @@
     for (const [name, v] of Object.entries(m)) {
       if (name === "t" || name === "tick" || typeof v !== "number") continue;
       if (!scope.series.has(name)) {
-        scope.add(name, unitFor(name, units));
+        scope.add(name, groupFor(name, units), units[name] || "");
         addChannelToggle(name);
       }
       scope.series.get(name).push(m.t, v);
@@ -144,13 +145,15 @@
     for (const id of ["take-control", "release-control", "send-setpoint"]) $(id).disabled = !page.commandsOffered;
   }
 
-  function answerLine(text, reason, command) {
-    const li = document.createElement("li");
+  // One line per command: "sent", then replaced by the rig's answer.
+  function answerLine(text, reason, command, id) {
+    const li = (id && document.querySelector(`#answers li[data-id="${id}"]`)) || document.createElement("li");
+    if (id) li.dataset.id = String(id);
     li.textContent = text;
     li.dataset.reason = reason;
     li.dataset.command = command;
     li.className = reason === "accepted" ? "good" : reason === "pending" ? "muted" : "bad";
-    $("answers").prepend(li);
+    if (!li.parentNode) $("answers").prepend(li);
     while ($("answers").children.length > 30) $("answers").lastChild.remove();
     return li;
   }
@@ -158,7 +161,7 @@
   function showAnswer(a) {
     if (a.command === "take_control" && a.accepted) page.holdsControl = true;
     if (a.command === "release_control" && a.accepted) page.holdsControl = false;
-    answerLine("#" + a.id + " " + a.command + ": " + a.reason + (a.message ? " \u2014 " + a.message : ""), a.reason, a.command);
+    answerLine("#" + a.id + " " + a.command + ": " + a.reason + (a.message ? " \u2014 " + a.message : ""), a.reason, a.command, a.id);
     $("control").className = "badge " + (page.holdsControl ? "mine" : $("control").textContent === "control: free" ? "" : "other");
   }
 
@@ -179,7 +182,7 @@
     c.id = ++page.requestId;
     page.lastSent = c;
     page.client.publish(c);
-    return answerLine("#" + c.id + " " + command + ": sent", "pending", command);
+    return answerLine("#" + c.id + " " + command + ": sent", "pending", command, c.id);
   }
 
   // Sends the last signed command again, byte for byte (a captured command
@@ -188,11 +191,14 @@
     if (!page.lastSent) return;
     const c = Object.assign({}, page.lastSent, { id: ++page.requestId });
     page.client.publish(c);
-    answerLine("#" + c.id + " " + c.command + " (again): sent", "pending", c.command);
+    answerLine("#" + c.id + " " + c.command + " (again): sent", "pending", c.command, c.id);
   }
 
   function release() {
-    if (page.client && page.client.open) page.client.publish({ id: ++page.requestId, command: "release_control" });
+    if (!page.client || !page.client.open) return;
+    const id = ++page.requestId;
+    page.client.publish({ id, command: "release_control" });
+    answerLine("#" + id + " release_control: sent", "pending", "release_control", id);
   }
 
   // --- wiring -----------------------------------------------------------------
@@ -254,5 +260,5 @@
   connect();
   requestAnimationFrame(frame);
   // For the browser test and the curious: the same functions the buttons use.
-  window.rigctlConsole = { send, replayLast, release, scope };
+  window.rigctlConsole = { send, replayLast, release, scope, disconnect: () => page.client.ws.close() };
 })();

@@ -8,8 +8,11 @@ window.rigctl = window.rigctl || {};
 
 rigctl.Series = class {
   // 2^15 points: 60 s at 400 Hz (24000) with room to spare.
-  constructor(name, unit, capacity = 32768) {
+  // group: the strip it is drawn in (its unit, or "demand" for the setpoint
+  // and its feedback); unit: its SI unit ("" when the message does not say).
+  constructor(name, group, unit, capacity = 32768) {
     this.name = name;
+    this.group = group;
     this.unit = unit;
     this.t = new Float64Array(capacity);
     this.v = new Float64Array(capacity);
@@ -47,8 +50,8 @@ rigctl.Scope = class {
     this.colors = ["#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf"];
   }
 
-  add(name, unit) {
-    if (!this.series.has(name)) this.series.set(name, new rigctl.Series(name, unit));
+  add(name, group, unit) {
+    if (!this.series.has(name)) this.series.set(name, new rigctl.Series(name, group, unit));
     return this.series.get(name);
   }
 
@@ -68,10 +71,11 @@ rigctl.Scope = class {
     for (const name of this.selected) {
       const s = this.series.get(name);
       if (!s) continue;
-      if (!byUnit.has(s.unit)) byUnit.set(s.unit, []);
-      byUnit.get(s.unit).push(s);
+      if (!byUnit.has(s.group)) byUnit.set(s.group, []);
+      byUnit.get(s.group).push(s);
     }
-    return [...byUnit.entries()];
+    // Each strip labelled with the unit its channels name.
+    return [...byUnit.values()].map((list) => [(list.find((s) => s.unit) || { unit: "" }).unit, list]);
   }
 
   draw() {
