@@ -138,6 +138,12 @@ async function disconnectMidCommand(a, b, result) {
 
 async function commandsScenario(browser, args, result, log) {
   const a = await openConsole(browser, args.url, log);
+  // The page's signing against the test vector of docs/operator-commands.md.
+  result.testVector = await a.evaluate(async () => {
+    const key = Array.from({ length: 32 }, (_, i) => i.toString(16).padStart(2, "0")).join("");
+    const c = { version: 1, sender: "alice@rigpc", sequence: 42, utime: 1700000000000000, command: "setpoint", value: 0.01 };
+    return { canonical: rigctl.signing.toHex(rigctl.signing.canonicalBytes(c)), tag: await rigctl.signing.sign(key, c) };
+  });
   await tracesUpdate(a, result);
   await setField(a, "#sender", "alice");
   await setField(a, "#key", args.key);
@@ -166,6 +172,7 @@ async function commandsScenario(browser, args, result, log) {
 async function tripScenario(browser, args, result, log) {
   const a = await openConsole(browser, args.url, log);
   await a.waitForSelector("#detectors tr.tripped");
+  await a.waitForSelector("#timing tr");  // the loop's timing, published about once a second
   await setField(a, "#sender", "alice");
   await setField(a, "#key", args.key);
   await a.click("#take-control");

@@ -106,6 +106,13 @@ TEST_F(Console, SignedCommandsFromTheBrowserDriveTheRigAndForgeriesChangeNothing
   ASSERT_EQ(rig->stop(), 0) << rig->output();
   ASSERT_FALSE(r.contains("error")) << r.dump(2);
 
+  // WebCrypto in chromium signs the canonical bytes as the rig does (the
+  // test vector of docs/operator-commands.md).
+  const std::string canonical = r["testVector"]["canonical"];
+  EXPECT_EQ(canonical.size(), 2u * 82);
+  EXPECT_EQ(canonical.substr(0, 8), "72696763");
+  EXPECT_EQ(canonical.substr(canonical.size() - 16), "3f847ae147ae147b");
+  EXPECT_EQ(r["testVector"]["tag"], "5346b1f0a62ff91f2d21aba62f9e9eed9d13b6ba6a939b321319de2fc82773fd");
   EXPECT_GT(r["samplesSeen"].get<int>(), 600);  // the traces updated
   EXPECT_GT(r["framesDrawn"].get<int>(), 0);
   EXPECT_EQ(r["takeControl"]["reason"], "accepted") << r["takeControl"];
