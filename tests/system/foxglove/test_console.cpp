@@ -19,6 +19,7 @@
 #include "node_client.hpp"
 #include "process.hpp"
 #include "read_file.hpp"
+#include "state_changes.hpp"
 
 namespace {
 
@@ -42,17 +43,6 @@ std::string hex(const std::string& bytes) {
   return out;
 }
 
-// "from -> to" of every state_changed line of an event log, in order.
-std::vector<std::string> state_changes(const std::string& events) {
-  std::vector<std::string> out;
-  const std::regex re("code=state_changed .*message=\"([a-z_]+ -> [a-z_]+)\"");
-  std::istringstream in(events);
-  for (std::string line; std::getline(in, line);) {
-    std::smatch m;
-    if (std::regex_search(line, m, re)) out.push_back(m[1]);
-  }
-  return out;
-}
 
 int count_lines(const std::string& text, const std::string& fragment) {
   int n = 0;
