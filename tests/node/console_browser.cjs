@@ -81,6 +81,19 @@ async function tracesUpdate(page, result) {
   result.framesDrawn = await page.evaluate(() => window.rigctlConsole.scope.drawn);
 }
 
+// Pause freezes the plot's window, not the record; the window goes to 60 s.
+async function pauseAndWindow(page, result) {
+  await page.click("#pause");
+  const before = await page.evaluate(() => ({ end: window.rigctlConsole.scope.frozenEnd, n: Number(document.getElementById("scope-stats").dataset.samples) }));
+  await page.waitForFunction((n) => Number(document.getElementById("scope-stats").dataset.samples) > n + 200, POLL, before.n);
+  const after = await page.evaluate(() => ({ end: window.rigctlConsole.scope.frozenEnd, n: Number(document.getElementById("scope-stats").dataset.samples) }));
+  await page.click("#pause");
+  await page.$eval("#window", (e) => { e.value = "60"; e.dispatchEvent(new Event("input")); });
+  result.paused = { endBefore: before.end, endAfter: after.end, samplesBefore: before.n, samplesAfter: after.n,
+                    windowS: await page.evaluate(() => window.rigctlConsole.scope.windowS) };
+  await page.$eval("#window", (e) => { e.value = "5"; e.dispatchEvent(new Event("input")); });  // for the screenshot
+}
+
 async function driveToRunning(page, result) {
   const steps = [["reset", "off"], ["hydraulics_low", "hydraulics_low"], ["hydraulics_high", "hydraulics_high"],
                  ["arm", "armed"], ["start", "running"]];
@@ -145,12 +158,14 @@ async function commandsScenario(browser, args, result, log) {
     return { canonical: rigctl.signing.toHex(rigctl.signing.canonicalBytes(c)), tag: await rigctl.signing.sign(key, c) };
   });
   await tracesUpdate(a, result);
+  await pauseAndWindow(a, result);
   await setField(a, "#sender", "alice");
   await setField(a, "#key", args.key);
   await a.click("#take-control");
   result.takeControl = await answer(a, "take_control");
   await driveToRunning(a, result);
-  await a.waitForFunction((n) => Number(document.getElementById("scope-stats").dataset.samples) > n, POLL, result.samplesSeen + 800);
+  // 4 s of running (400 samples a second): the ramp away from home is on the screenshot.
+  await a.waitForFunction((n) => Number(document.getElementById("scope-stats").dataset.samples) > n, POLL, (await samples(a)) + 1600);
   await a.screenshot({ path: path.join(args.screenshots, "scope.png") });
   await refusalsAndHold(a, args, result);
   const station = await a.$("#station-panel");

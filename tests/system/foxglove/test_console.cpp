@@ -57,8 +57,11 @@ class Console : public ::testing::Test {
     dir_ = fs::temp_directory_path() / ("rigctl_console_" + std::to_string(::getpid()) + "_" +
                                         ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::create_directories(dir_);
-    // Paced on a loaded machine: an overrun burst indicates rather than stops.
-    std::ofstream(path("quarter_car.yaml")) << without_overrun_stop(shipped_config());
+    // Paced on a loaded machine: an overrun burst indicates rather than stops;
+    // steps held 60 s, so the profile (which ends in a hold of its own in
+    // operator mode) outlasts the test however slowly the browser goes.
+    std::ofstream(path("quarter_car.yaml"))
+        << edit(without_overrun_stop(shipped_config()), "step_hold_s: 4\\.0", "step_hold_s: 60.0");
     std::ofstream(path("rig.key")) << key_bytes(1);
     fs::permissions(path("rig.key"), fs::perms::owner_read | fs::perms::owner_write, fs::perm_options::replace);
   }
@@ -105,6 +108,10 @@ TEST_F(Console, SignedCommandsFromTheBrowserDriveTheRigAndForgeriesChangeNothing
   EXPECT_EQ(r["testVector"]["tag"], "5346b1f0a62ff91f2d21aba62f9e9eed9d13b6ba6a939b321319de2fc82773fd");
   EXPECT_GT(r["samplesSeen"].get<int>(), 600);  // the traces updated
   EXPECT_GT(r["framesDrawn"].get<int>(), 0);
+  // Paused, the plot stands still while every sample is still recorded.
+  EXPECT_EQ(r["paused"]["endBefore"], r["paused"]["endAfter"]) << r["paused"];
+  EXPECT_GT(r["paused"]["samplesAfter"].get<int>(), r["paused"]["samplesBefore"].get<int>() + 100) << r["paused"];
+  EXPECT_EQ(r["paused"]["windowS"], 60);
   EXPECT_EQ(r["takeControl"]["reason"], "accepted") << r["takeControl"];
   for (const auto& a : r["answers"]) EXPECT_EQ(a["reason"], "accepted") << a;
   // Refused with their reasons, and the rig stayed running.
