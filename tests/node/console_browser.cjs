@@ -120,6 +120,14 @@ async function refusalsAndHold(page, args, result) {
   result.replayed = await answer(page, "hold", 4);
   await waitState(page, "holding");
   result.stateAfterHold = await state(page);
+  // A held setpoint inside the configured range, then one outside it.
+  await setField(page, "#setpoint", "0.02");
+  await page.click("#send-setpoint");
+  result.setpoint = await answer(page, "setpoint", 1);
+  await page.waitForFunction(() => /setpoint 0\.02 accepted/.test(document.getElementById("events").textContent), POLL);
+  await setField(page, "#setpoint", "0.5");
+  await page.click("#send-setpoint");
+  result.setpointOutOfRange = await answer(page, "setpoint", 2);
 }
 
 async function secondConsole(browser, args, result, log) {

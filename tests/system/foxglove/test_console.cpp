@@ -122,6 +122,8 @@ TEST_F(Console, SignedCommandsFromTheBrowserDriveTheRigAndForgeriesChangeNothing
   EXPECT_EQ(r["hold"]["reason"], "accepted") << r["hold"];
   EXPECT_EQ(r["replayed"]["reason"], "replayed") << r["replayed"];
   EXPECT_EQ(r["stateAfterHold"], "holding");
+  EXPECT_EQ(r["setpoint"]["reason"], "accepted") << r["setpoint"];
+  EXPECT_EQ(r["setpointOutOfRange"]["reason"], "out_of_limits") << r["setpointOutOfRange"];
   // The second console watches: it cannot command, nor take control.
   EXPECT_EQ(r["secondHold"]["reason"], "not_in_control") << r["secondHold"];
   EXPECT_EQ(r["secondTakeControl"]["reason"], "control_held") << r["secondTakeControl"];
@@ -148,6 +150,7 @@ TEST_F(Console, SignedCommandsFromTheBrowserDriveTheRigAndForgeriesChangeNothing
   EXPECT_EQ(std::vector<std::string>(changes.begin(), changes.begin() + 6), expected) << events;
   EXPECT_EQ(changes.back(), "stopping -> hydraulics_high") << events;
   EXPECT_EQ(count_lines(events, "message=\"hold accepted\""), 1) << events;
+  EXPECT_EQ(count_lines(events, "message=\"setpoint 0.02 accepted\""), 1) << events;
   for (const char* reason : {"(bad_tag)", "(stale)", "(replayed)"}) {
     EXPECT_EQ(count_lines(events, "operator command rejected " + std::string(reason)), 1) << reason << "\n" << events;
   }

@@ -4,6 +4,9 @@
 // reach the command receiver's queue, the one the loop reads.
 #include <gtest/gtest.h>
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -151,6 +154,42 @@ TEST(ConsoleAssets, ThePageIsServedFromTheProgram) {
   EXPECT_EQ(serve_console_asset("/console.css").content_type, "text/css; charset=utf-8");
   const auto missing = serve_console_asset("/../etc/passwd");
   EXPECT_EQ(missing.status, 404);
+}
+
+// One HTTP request to 127.0.0.1:port; the whole response (the server closes).
+std::string http(uint16_t port, const std::string& request) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(port);
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
+    ::close(fd);
+    return "connect failed";
+  }
+  (void)!::write(fd, request.data(), request.size());
+  std::string out;
+  char buffer[4096];
+  for (ssize_t n; (n = ::read(fd, buffer, sizeof buffer)) > 0;) out.append(buffer, static_cast<std::size_t>(n));
+  ::close(fd);
+  return out;
+}
+
+TEST(ConsoleAssets, TheServerAnswersPlainHttpOnItsWebSocketPort) {
+  ServerOptions so;
+  so.port = 0;
+  Server server(so);
+  server.set_http_handler(serve_console_asset);
+  server.start();
+  const std::string page = http(server.port(), "GET /?x=1 HTTP/1.1\r\nHost: rig\r\nConnection: close\r\n\r\n");
+  EXPECT_EQ(page.rfind("HTTP/1.1 200", 0), 0u) << page.substr(0, 200);
+  EXPECT_NE(page.find("Content-Security-Policy: default-src 'self'"), std::string::npos);
+  EXPECT_NE(page.find("<title>rigctl console</title>"), std::string::npos);
+  const std::string missing = http(server.port(), "GET /nope HTTP/1.1\r\nHost: rig\r\nConnection: close\r\n\r\n");
+  EXPECT_EQ(missing.rfind("HTTP/1.1 404", 0), 0u) << missing.substr(0, 200);
+  const std::string post = http(server.port(), "POST / HTTP/1.1\r\nHost: rig\r\nContent-Length: 0\r\nConnection: close\r\n\r\n");
+  EXPECT_EQ(post.rfind("HTTP/1.1 405", 0), 0u) << post.substr(0, 200);
+  server.stop();
 }
 
 TEST(Station, TheCommandTableIsTheStateMachines) {
