@@ -21,6 +21,10 @@ class TelemetryServer {
  public:
   // Binds (throws std::runtime_error naming the address and port).
   TelemetryServer(const ServerOptions& options, const std::string& channel_prefix, std::vector<Parameter> parameters);
+  // Stops the server first: its thread may still call the console's gateway.
+  ~TelemetryServer() { server_.stop(); }
+  TelemetryServer(const TelemetryServer&) = delete;
+  TelemetryServer& operator=(const TelemetryServer&) = delete;
 
   // Before start(): the console's commands go to `receiver` (operator mode).
   void enable_console_commands(CommandReceiver& receiver);

@@ -196,6 +196,15 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
     commands = &receiver->queue();
     if (foxglove_server) foxglove_server->enable_console_commands(*receiver);
   }
+  // The console's gateway hands commands to the receiver from the server's
+  // thread: on any way out of this function the server stops before the
+  // receiver goes (this guard, declared after it, is destroyed first).
+  struct StopServer {
+    foxglove::TelemetryServer* server;
+    ~StopServer() {
+      if (server != nullptr) server->stop();
+    }
+  } const stop_console_before_receiver{receiver ? foxglove_server.get() : nullptr};
   // Counts the loop's ticks for the systemd watchdog (a no-op outside systemd).
   LoopHeartbeat heartbeat(publisher);
   ServiceNotifier notifier(heartbeat.beats());
