@@ -11,15 +11,18 @@ namespace rigctl::foxglove {
 using nlohmann::json;
 
 std::string server_info_json(const std::string& name, const std::map<std::string, std::string>& metadata,
-                             const std::string& session_id) {
-  // Only `parameters`: no clientPublish (operator commands keep their signed
-  // LCM path), no services, no time messages (message times are the samples').
-  return json{{"op", "serverInfo"},
-              {"name", name},
-              {"capabilities", json::array({"parameters"})},
-              {"metadata", metadata},
-              {"sessionId", session_id}}
-      .dump();
+                             const std::string& session_id, bool client_publish) {
+  // `parameters`, and clientPublish only when the operator console takes
+  // signed commands; no services, no time messages (message times are the
+  // samples').
+  json capabilities = json::array({"parameters"});
+  json out{{"op", "serverInfo"}, {"name", name}, {"metadata", metadata}, {"sessionId", session_id}};
+  if (client_publish) {
+    capabilities.push_back("clientPublish");
+    out["supportedEncodings"] = json::array({"json"});
+  }
+  out["capabilities"] = capabilities;
+  return out.dump();
 }
 
 std::string advertise_json(const std::vector<AdvertisedChannel>& channels) {
@@ -78,7 +81,16 @@ ClientRequest read_request(const json& j) {
     if (r.kind == ClientRequest::Kind::kSetParameters) {  // answered with the values they keep
       for (const auto& p : j.at("parameters")) r.parameter_names.push_back(p.at("name").get<std::string>());
     }
-  } else if (r.op == "advertise" || r.op == "unadvertise" || r.op == "subscribeParameterUpdates" ||
+  } else if (r.op == "advertise") {
+    r.kind = ClientRequest::Kind::kAdvertise;
+    for (const auto& c : j.at("channels")) {
+      r.client_channels.push_back({c.at("id").get<uint32_t>(), c.at("topic").get<std::string>(),
+                                   c.at("encoding").get<std::string>(), c.value("schemaName", std::string())});
+    }
+  } else if (r.op == "unadvertise") {
+    r.kind = ClientRequest::Kind::kUnadvertise;
+    for (const auto& id : j.at("channelIds")) r.unadvertised.push_back(id.get<uint32_t>());
+  } else if (r.op == "subscribeParameterUpdates" ||
              r.op == "unsubscribeParameterUpdates" || r.op == "subscribeConnectionGraph" ||
              r.op == "unsubscribeConnectionGraph" || r.op == "fetchAsset") {
     r.kind = ClientRequest::Kind::kRefused;  // capabilities the server does not offer
@@ -107,6 +119,14 @@ ClientRequest parse_client_request(const std::string& text) {
     r.error = e.what();
     return r;
   }
+}
+
+std::optional<ClientMessageData> parse_client_message_data(const std::string& frame) {
+  if (frame.size() < 5 || static_cast<uint8_t>(frame[0]) != 0x01) return std::nullopt;
+  ClientMessageData m;
+  for (int i = 0; i < 4; ++i) m.channel |= static_cast<uint32_t>(static_cast<uint8_t>(frame[1 + i])) << (8 * i);
+  m.payload = frame.substr(5);
+  return m;
 }
 
 std::optional<std::string> choose_subprotocol(const std::vector<std::string>& offered) {

@@ -3,6 +3,7 @@
 // (under the mutex) and post a flush.
 #include "foxglove/server/server.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <mutex>
@@ -44,9 +45,11 @@ constexpr long kCloseTimeoutMs = 1000;
 constexpr auto kFlushInterval = std::chrono::milliseconds(5);
 
 struct Client {
-  Client(Hdl h, std::size_t capacity) : hdl(std::move(h)), queue(capacity) {}
+  Client(uint64_t i, Hdl h, std::size_t capacity) : id(i), hdl(std::move(h)), queue(capacity) {}
+  uint64_t id;
   Hdl hdl;
   std::map<uint32_t, uint32_t> subscription_of_channel;
+  std::map<uint32_t, ClientChannel> advertised;  // the client's own channels (clientPublish)
   ClientQueue queue;
   ClientStats stats;
 };
@@ -60,6 +63,9 @@ struct Server::Impl {
   uint16_t port = 0;
   std::string session_id;
   std::unique_ptr<asio::steady_timer> flush_timer;
+  HttpHandler http;                                  // set before start()
+  ClientPublishHandler* publish_handler = nullptr;   // likewise
+  std::vector<std::string> publish_topics;
 
   mutable std::mutex mu;  // everything below
   std::map<Hdl, std::shared_ptr<Client>, std::owner_less<Hdl>> clients;
@@ -67,6 +73,7 @@ struct Server::Impl {
   std::vector<AdvertisedChannel> channels;
   std::map<std::string, std::pair<StatusLevel, std::string>> statuses;
   std::vector<Parameter> parameters;
+  uint64_t next_client_id = 1;
   bool stopped = false;
   std::atomic<bool> stopping{false};  // the flush timer must not re-arm once set
 
@@ -110,12 +117,13 @@ struct Server::Impl {
 
   void on_open(const Hdl& hdl) {
     auto con = ws.get_con_from_hdl(hdl);
-    auto c = std::make_shared<Client>(hdl, options.client_queue_messages);
-    c->stats.address = con->get_remote_endpoint();
-    c->stats.subprotocol = con->get_subprotocol();
-    std::vector<std::string> greeting{server_info_json(options.name, options.metadata, session_id)};
+    std::vector<std::string> greeting{
+        server_info_json(options.name, options.metadata, session_id, publish_handler != nullptr)};
     {
       std::lock_guard<std::mutex> lock(mu);
+      auto c = std::make_shared<Client>(next_client_id++, hdl, options.client_queue_messages);
+      c->stats.address = con->get_remote_endpoint();
+      c->stats.subprotocol = con->get_subprotocol();
       clients.emplace(hdl, c);
       seen.push_back(c);
       greeting.push_back(advertise_json(channels));
@@ -125,19 +133,65 @@ struct Server::Impl {
   }
 
   void on_close(const Hdl& hdl) {
-    std::lock_guard<std::mutex> lock(mu);
-    clients.erase(hdl);
+    std::shared_ptr<Client> gone;
+    {
+      std::lock_guard<std::mutex> lock(mu);
+      const auto it = clients.find(hdl);
+      if (it == clients.end()) return;  // a handshake that failed: never opened
+      gone = it->second;
+      clients.erase(it);
+    }
+    if (publish_handler != nullptr) publish_handler->on_client_closed(gone->id);
+  }
+
+  // A binary frame: a message on a channel the client advertised, handed to
+  // the publish handler; anything else is answered with a warning.
+  void on_client_data(const Hdl& hdl, const Client& c, const std::string& frame) {
+    const auto data = parse_client_message_data(frame);
+    if (!data) {
+      send_text(hdl, status_json("bad_client_message", StatusLevel::kWarning,
+                                 "unreadable binary message: only opcode 1 (client message data) is accepted"));
+      return;
+    }
+    std::string topic;
+    {
+      std::lock_guard<std::mutex> lock(mu);
+      const auto it = c.advertised.find(data->channel);
+      if (it != c.advertised.end()) topic = it->second.topic;
+    }
+    if (topic.empty() || publish_handler == nullptr) {
+      send_text(hdl, status_json("bad_client_message", StatusLevel::kWarning,
+                                 "client channel " + std::to_string(data->channel) + " was not advertised"));
+      return;
+    }
+    publish_handler->on_client_message(c.id, topic, data->payload);
+  }
+
+  // Client channels: JSON on one of the accepted topics, or refused.
+  void on_advertise(const Hdl& hdl, Client& c, const ClientRequest& r) {
+    for (const auto& ch : r.client_channels) {
+      const bool topic_ok = std::find(publish_topics.begin(), publish_topics.end(), ch.topic) != publish_topics.end();
+      if (publish_handler == nullptr || !topic_ok || ch.encoding != "json") {
+        send_text(hdl, status_json("refused_advertise", StatusLevel::kWarning,
+                                   publish_handler == nullptr
+                                       ? "rigctl serves read-only telemetry here: client publishing is not offered"
+                                       : "client channel '" + ch.topic + "' (" + ch.encoding +
+                                             ") refused: only JSON on the console's command topic"));
+        continue;
+      }
+      std::lock_guard<std::mutex> lock(mu);
+      c.advertised[ch.id] = ch;
+    }
   }
 
   void on_message(const Hdl& hdl, WsServer::message_ptr msg) {
+    auto c = client(hdl);
+    if (!c) return;
     if (msg->get_opcode() != websocketpp::frame::opcode::text) {
-      send_text(hdl, status_json("client_publish", StatusLevel::kError,
-                                 "rigctl does not accept client messages: the rig is commanded with rigctl cmd"));
+      on_client_data(hdl, *c, msg->get_payload());
       return;
     }
     const ClientRequest r = parse_client_request(msg->get_payload());
-    auto c = client(hdl);
-    if (!c) return;
     switch (r.kind) {
       case ClientRequest::Kind::kSubscribe: {
         std::lock_guard<std::mutex> lock(mu);
@@ -153,6 +207,14 @@ struct Server::Impl {
             it = it->second == sub ? c->subscription_of_channel.erase(it) : std::next(it);
           }
         }
+        return;
+      }
+      case ClientRequest::Kind::kAdvertise:
+        on_advertise(hdl, *c, r);
+        return;
+      case ClientRequest::Kind::kUnadvertise: {
+        std::lock_guard<std::mutex> lock(mu);
+        for (const auto id : r.unadvertised) c->advertised.erase(id);
         return;
       }
       case ClientRequest::Kind::kGetParameters:
@@ -212,6 +274,32 @@ struct Server::Impl {
     }
   }
 
+  void on_http(const Hdl& hdl) {
+    auto con = ws.get_con_from_hdl(hdl);
+    if (!http) {
+      con->set_status(websocketpp::http::status_code::upgrade_required);
+      con->set_body("rigctl speaks the Foxglove WebSocket protocol here\n");
+      return;
+    }
+    if (con->get_request().get_method() != "GET") {
+      con->set_status(websocketpp::http::status_code::method_not_allowed);
+      con->append_header("Allow", "GET");
+      return;
+    }
+    std::string path = con->get_resource();
+    path = path.substr(0, path.find('?'));
+    const HttpResponse r = http(path);
+    con->set_status(static_cast<websocketpp::http::status_code::value>(r.status));
+    con->append_header("Content-Type", r.content_type);
+    // The page and its scripts come from this server only, and nothing may
+    // frame it (a control page inside another site's frame is clickjacking).
+    con->append_header("Content-Security-Policy",
+                       "default-src 'self'; connect-src 'self'; img-src 'self' data:; frame-ancestors 'none'");
+    con->append_header("X-Content-Type-Options", "nosniff");
+    con->append_header("Cache-Control", "no-store");
+    con->set_body(r.body);
+  }
+
   void arm_flush_timer() {
     flush_timer->expires_after(kFlushInterval);
     flush_timer->async_wait([this](const asio::error_code& ec) {
@@ -245,6 +333,7 @@ Server::Server(ServerOptions options) : impl_(std::make_unique<Impl>(std::move(o
   s.ws.set_close_handler([&s](Hdl hdl) { s.on_close(hdl); });
   s.ws.set_fail_handler([&s](Hdl hdl) { s.on_close(hdl); });
   s.ws.set_message_handler([&s](Hdl hdl, WsServer::message_ptr m) { s.on_message(hdl, std::move(m)); });
+  s.ws.set_http_handler([&s](Hdl hdl) { s.on_http(hdl); });
   const std::string where = s.options.address + ":" + std::to_string(s.options.port);
   try {
     asio::error_code ec;
@@ -312,6 +401,13 @@ uint32_t Server::add_channel(const std::string& topic, const std::string& schema
   return c.id;
 }
 
+void Server::set_http_handler(HttpHandler handler) { impl_->http = std::move(handler); }
+
+void Server::accept_client_publish(ClientPublishHandler* handler, std::vector<std::string> topics) {
+  impl_->publish_handler = handler;
+  impl_->publish_topics = std::move(topics);
+}
+
 bool Server::has_subscribers(uint32_t channel) const {
   std::lock_guard<std::mutex> lock(impl_->mu);
   for (const auto& [hdl, c] : impl_->clients) {
@@ -323,6 +419,15 @@ bool Server::has_subscribers(uint32_t channel) const {
 void Server::publish(uint32_t channel, uint64_t log_time_ns, std::shared_ptr<const std::string> json) {
   std::lock_guard<std::mutex> lock(impl_->mu);
   for (const auto& [hdl, c] : impl_->clients) {
+    const auto it = c->subscription_of_channel.find(channel);
+    if (it != c->subscription_of_channel.end()) c->queue.push(QueuedMessage{it->second, log_time_ns, json});
+  }
+}
+
+void Server::publish_to(uint64_t client, uint32_t channel, uint64_t log_time_ns, std::shared_ptr<const std::string> json) {
+  std::lock_guard<std::mutex> lock(impl_->mu);
+  for (const auto& [hdl, c] : impl_->clients) {
+    if (c->id != client) continue;
     const auto it = c->subscription_of_channel.find(channel);
     if (it != c->subscription_of_channel.end()) c->queue.push(QueuedMessage{it->second, log_time_ns, json});
   }

@@ -1,8 +1,10 @@
 // A Foxglove WebSocket protocol server (docs/foxglove.md): channels with JSON
 // schemas and JSON messages, status messages with ids, read-only parameters.
 // It knows nothing of rigs: the telemetry feed (foxglove/telemetry) decides
-// what is published. Clients may only listen: no client publishing, and
-// parameters cannot be set.
+// what is published. Parameters cannot be set. Clients may publish only
+// when a ClientPublishHandler is set, and only on the topics it names (the
+// operator console's commands, foxglove/console); plain HTTP GETs on the same
+// port are answered by the HttpHandler when one is set (the console's page).
 //
 // Threads: publish(), add_channel(), set_status() and remove_status() may be
 // called from any thread and never wait for a client: each client has its
@@ -16,6 +18,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -59,6 +62,26 @@ struct ServerStats {
   std::vector<ClientStats> per_client;  // every client seen, in order of connection
 };
 
+// An HTTP request on the WebSocket port that is not an upgrade.
+struct HttpResponse {
+  int status = 200;
+  std::string content_type = "text/plain; charset=utf-8";
+  std::string body;
+};
+// Called on the server's thread with the path of a GET (query removed).
+using HttpHandler = std::function<HttpResponse(const std::string& path)>;
+
+// Messages clients publish on a channel they advertised (capability
+// clientPublish). Called on the server's thread; must not throw.
+class ClientPublishHandler {
+ public:
+  virtual ~ClientPublishHandler() = default;
+  // `client`: the server's id of the connection (ids are never reused).
+  virtual void on_client_message(uint64_t client, const std::string& topic, const std::string& payload) = 0;
+  // The connection is gone (closed, failed or the server stopped).
+  virtual void on_client_closed(uint64_t client) = 0;
+};
+
 class Server {
  public:
   // Binds and listens; throws std::runtime_error naming address and port.
@@ -73,12 +96,21 @@ class Server {
   uint16_t port() const;
   const std::string& address() const;
 
+  // Before start(): plain HTTP GETs are answered by `handler` (without one,
+  // websocketpp's "426 Upgrade Required").
+  void set_http_handler(HttpHandler handler);
+  // Before start(): offer clientPublish for these topics (JSON encoding)
+  // only; advertisements of any other topic are refused with a status.
+  void accept_client_publish(ClientPublishHandler* handler, std::vector<std::string> topics);
+
   // A channel of JSON messages with a JSON schema (schema encoding
   // "jsonschema"); advertised to every client now and to each new one.
   uint32_t add_channel(const std::string& topic, const std::string& schema_name, const std::string& schema);
   bool has_subscribers(uint32_t channel) const;
   // Queues the message for every client subscribed to the channel.
   void publish(uint32_t channel, uint64_t log_time_ns, std::shared_ptr<const std::string> json);
+  // Queues the message for one client, if it is connected and subscribed.
+  void publish_to(uint64_t client, uint32_t channel, uint64_t log_time_ns, std::shared_ptr<const std::string> json);
 
   // A status with an id stays active (and is sent to clients that connect
   // later) until remove_status() sends removeStatus for it.

@@ -2,12 +2,19 @@
 
 #include <sstream>
 
+#include "foxglove/console/console_assets.hpp"
+
 namespace rigctl::foxglove {
 
 TelemetryServer::TelemetryServer(const ServerOptions& options, const std::string& channel_prefix,
                                  std::vector<Parameter> parameters)
     : server_(options), feed_(server_, channel_prefix) {
   server_.set_parameters(std::move(parameters));
+  server_.set_http_handler(serve_console_asset);
+}
+
+void TelemetryServer::enable_console_commands(CommandReceiver& receiver) {
+  console_ = std::make_unique<ConsoleGateway>(server_, receiver);
 }
 
 std::string TelemetryServer::url() const {

@@ -1,11 +1,16 @@
 // A Foxglove server fed with rigctl's telemetry: the server and its feed in
 // one object, for `rigctl run --ws` (fed by the publisher's tap) and `rigctl
 // bridge` (fed from an LCM network). Construct and start() it before the
-// real-time set-up, so its thread keeps normal priority.
+// real-time set-up, so its thread keeps normal priority. It also serves the
+// operator console's page at `/` (docs/console.md), which takes commands
+// once enable_console_commands() is given the run's command receiver.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
+
+#include "foxglove/console/console_gateway.hpp"
 
 #include "foxglove/server/server.hpp"
 #include "foxglove/telemetry/telemetry_feed.hpp"
@@ -16,6 +21,13 @@ class TelemetryServer {
  public:
   // Binds (throws std::runtime_error naming the address and port).
   TelemetryServer(const ServerOptions& options, const std::string& channel_prefix, std::vector<Parameter> parameters);
+  // Stops the server first: its thread may still call the console's gateway.
+  ~TelemetryServer() { server_.stop(); }
+  TelemetryServer(const TelemetryServer&) = delete;
+  TelemetryServer& operator=(const TelemetryServer&) = delete;
+
+  // Before start(): the console's commands go to `receiver` (operator mode).
+  void enable_console_commands(CommandReceiver& receiver);
 
   void start() { server_.start(); }
   void stop() { server_.stop(); }
@@ -29,6 +41,7 @@ class TelemetryServer {
  private:
   Server server_;
   TelemetryFeed feed_;
+  std::unique_ptr<ConsoleGateway> console_;
 };
 
 }  // namespace rigctl::foxglove

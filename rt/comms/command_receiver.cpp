@@ -81,7 +81,17 @@ void CommandReceiver::run() {
 
 void CommandReceiver::on_message(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
   const int64_t now = wall_utime();
-  DecodedCommand d = verifier_.verify(rbuf->data, rbuf->data_size, now);
+  const DecodedCommand d = accept(rbuf->data, rbuf->data_size, now);
+  // Nothing to address a reply to when the message did not decode as far as
+  // its sender id.
+  if (!d.sender.empty() && valid_sender_id(d.sender)) reply(d, now);
+}
+
+DecodedCommand CommandReceiver::submit(const void* data, std::size_t size) { return accept(data, size, wall_utime()); }
+
+DecodedCommand CommandReceiver::accept(const void* data, std::size_t size, int64_t now) {
+  std::lock_guard<std::mutex> lock(producer_mu_);
+  DecodedCommand d = verifier_.verify(data, size, now);
   if (d.ok()) {
     if (queue_.try_push(d.command)) {
       spdlog::info("operator command '{}'{} from '{}' (sequence {}) accepted", to_string(d.command.kind),
@@ -95,9 +105,7 @@ void CommandReceiver::on_message(const lcm::ReceiveBuffer* rbuf, const std::stri
     }
   }
   if (!d.ok()) log_rejection(d, now);
-  // Nothing to address a reply to when the message did not decode as far as
-  // its sender id.
-  if (!d.sender.empty() && valid_sender_id(d.sender)) reply(d, now);
+  return d;
 }
 
 void CommandReceiver::reply(const DecodedCommand& d, int64_t now_utime) {

@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <thread>
 
@@ -66,6 +67,14 @@ class CommandReceiver {
   void start();
   void stop();  // joins the thread; idempotent
 
+  // A command that came another way than LCM (the browser console,
+  // foxglove/console): the LCM bytes of an operator_command_t, checked by
+  // the same verifier and replay table, logged the same way and queued on
+  // the same queue the loop reads, so there is one path into the state
+  // machine. Any thread (a mutex serialises the producers; the loop's side
+  // stays lock-free). The answer goes back to the caller, not on LCM.
+  DecodedCommand submit(const void* data, std::size_t size);
+
   // Consumer side for the loop (single consumer).
   SpscQueue<OperatorCommand>& queue() { return queue_; }
 
@@ -73,10 +82,16 @@ class CommandReceiver {
   const RejectCounters& counters() const { return verifier_.counters(); }
   uint64_t acks_sent() const { return acks_sent_.load(std::memory_order_relaxed); }
   const std::string& channel() const { return channel_; }
+  // The rig's key and policy (both fixed at construction): the console
+  // checks its take-control claims with them (foxglove/console).
+  const OperatorKey& key() const { return verifier_.key(); }
+  const CommandPolicy& policy() const { return verifier_.policy(); }
   const std::string& ack_channel() const { return ack_channel_; }
 
  private:
   void on_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  // Verify, queue, log: the producer side, under producer_mu_.
+  DecodedCommand accept(const void* data, std::size_t size, int64_t now_utime);
   void reply(const DecodedCommand& d, int64_t now_utime);
   void log_rejection(const DecodedCommand& d, int64_t now_utime);
   void run();
@@ -85,6 +100,7 @@ class CommandReceiver {
   std::string ack_channel_;
   int logs_per_second_;
   std::function<void(const RejectionNote&)> on_rejection_logged_;
+  std::mutex producer_mu_;  // the verifier, the queue's producer side, the log rate limit
   OperatorVerifier verifier_;
   SpscQueue<OperatorCommand> queue_;
   std::unique_ptr<lcm::LCM> lcm_;

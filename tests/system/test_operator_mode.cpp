@@ -22,6 +22,7 @@
 #include "config_edit.hpp"
 #include "process.hpp"
 #include "read_file.hpp"
+#include "state_changes.hpp"
 #include "test_netns.hpp"
 #include "wait_until.hpp"
 
@@ -42,17 +43,7 @@ void write_key(const fs::path& p, char fill) {
   fs::permissions(p, fs::perms::owner_read | fs::perms::owner_write, fs::perm_options::replace);
 }
 
-// "from -> to" of every state_changed line, in file order.
-std::vector<std::string> state_changes(const std::string& events) {
-  std::vector<std::string> out;
-  const std::regex re("code=state_changed .*message=\"([a-z_]+ -> [a-z_]+)\"");
-  std::istringstream in(events);
-  for (std::string line; std::getline(in, line);) {
-    std::smatch m;
-    if (std::regex_search(line, m, re)) out.push_back(m[1]);
-  }
-  return out;
-}
+using rigctl::test::state_changes;
 
 class OperatorMode : public ::testing::Test {
  protected:

@@ -9,6 +9,7 @@
 
 #include "config/rig_config.hpp"
 #include "foxglove/telemetry/telemetry_server.hpp"
+#include "tools/run/console_station.hpp"
 #include "tools/run/rig_parameters.hpp"
 
 namespace rigctl {
@@ -52,6 +53,9 @@ int run_bridge(const BridgeOptions& options, const std::atomic<bool>& stop, std:
     parameters = rig_parameters(config);
     so.metadata["rig"] = std::string(to_string(config.rig));
     so.metadata["config"] = options.config_path;
+    // The console at `/` watches only here: commands go to the rig's own
+    // receiver with `rigctl cmd` (the bridge holds no key).
+    so.metadata[foxglove::kStationMetadataKey] = foxglove::station_json(console_station(config, ChannelLayout{}, ""));
   }
   foxglove::TelemetryServer server(so, options.channel_prefix, std::move(parameters));
   Forwarder forwarder(server.tap());

@@ -18,6 +18,7 @@
 #include "rt/comms/event_log.hpp"
 #include "rt/realtime.hpp"
 #include "rt/comms/telemetry_publisher.hpp"
+#include "tools/run/console_station.hpp"
 #include "tools/run/console_status.hpp"
 #include "tools/runfile/log2csv.hpp"
 #include "tools/run/loop_heartbeat.hpp"
@@ -80,7 +81,10 @@ std::string end_reason(const Event& e, const ChannelLayout& layout, const Driver
 }
 
 // The Foxglove server of the run, when the config or --ws asks for one.
-std::unique_ptr<foxglove::TelemetryServer> make_foxglove_server(const RigConfig& config, const RunOptions& options) {
+// Its page at `/` is the operator console, which takes signed commands in
+// operator mode (docs/console.md).
+std::unique_ptr<foxglove::TelemetryServer> make_foxglove_server(const RigConfig& config, const RunOptions& options,
+                                                                const foxglove::StationDescription& station) {
   const auto ws = websocket_settings(config.telemetry.websocket, options.websocket);
   if (!ws) return nullptr;
   foxglove::ServerOptions so;
@@ -90,7 +94,8 @@ std::unique_ptr<foxglove::TelemetryServer> make_foxglove_server(const RigConfig&
   so.name = "rigctl " + std::string(to_string(config.rig));
   so.metadata = {{"rig", std::string(to_string(config.rig))},
                  {"driver", std::string(to_string(config.driver))},
-                 {"config", options.config_path}};
+                 {"config", options.config_path},
+                 {foxglove::kStationMetadataKey, foxglove::station_json(station)}};
   return std::make_unique<foxglove::TelemetryServer>(so, config.telemetry.channel_prefix, rig_parameters(config));
 }
 
@@ -164,7 +169,9 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
                                   : static_cast<std::size_t>(10.0 / config.loop.period_s);
   // Before the publisher: the publisher's last messages at its stop still
   // reach the server's feed.
-  const auto foxglove_server = make_foxglove_server(config, options);
+  foxglove::StationDescription station = console_station(config, rig.driver->layout(), rig.setpoint_name);
+  station.commands = operator_run && options.operator_commands == nullptr;  // the run's own receiver takes them
+  const auto foxglove_server = make_foxglove_server(config, options, station);
   TelemetryPublisher publisher(meta, url, report.log_path, queue_capacity);
   for (TelemetryTap* tap : options.telemetry_taps) publisher.add_tap(tap);
   if (foxglove_server) publisher.add_tap(&foxglove_server->tap());
@@ -187,7 +194,17 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
     op.setpoint_unit = feedback < inputs.size() ? inputs[feedback].unit : "";
     receiver = make_operator_receiver(config, op, events);
     commands = &receiver->queue();
+    if (foxglove_server) foxglove_server->enable_console_commands(*receiver);
   }
+  // The console's gateway hands commands to the receiver from the server's
+  // thread: on any way out of this function the server stops before the
+  // receiver goes (this guard, declared after it, is destroyed first).
+  struct StopServer {
+    foxglove::TelemetryServer* server;
+    ~StopServer() {
+      if (server != nullptr) server->stop();
+    }
+  } const stop_console_before_receiver{receiver ? foxglove_server.get() : nullptr};
   // Counts the loop's ticks for the systemd watchdog (a no-op outside systemd).
   LoopHeartbeat heartbeat(publisher);
   ServiceNotifier notifier(heartbeat.beats());

@@ -19,7 +19,8 @@ packages=(cmake g++ make pkg-config liblcm-dev liblcm-bin libglib2.0-dev libmodb
           # standalone asio; nlohmann-json for the protocol's JSON and the
           # telemetry's JSON messages and schemas.
           libwebsocketpp-dev libasio-dev nlohmann-json3-dev
-          nodejs)          # the tests' real clients (tests/node: Foxglove ws-protocol, @mcap/core), npm packages installed into the build folder
+          nodejs           # the tests' real clients (tests/node: Foxglove ws-protocol, @mcap/core), npm packages installed into the build folder
+          chromium)        # the operator console's test (tests/node/console_browser.cjs): a real browser, headless, driven by puppeteer-core
 for arg in "$@"; do
   case "$arg" in
     --plots) packages+=(python3 python3-numpy python3-matplotlib) ;;

@@ -58,10 +58,32 @@ TEST(Protocol, ClientRequestsAreReadAndPublishingIsRefused) {
   const auto set = parse_client_request(R"({"op":"setParameters","parameters":[{"name":"controller.kp","value":1}],"id":"s"})");
   EXPECT_EQ(set.kind, ClientRequest::Kind::kSetParameters);
   EXPECT_EQ(set.parameter_names, std::vector<std::string>{"controller.kp"});
-  EXPECT_EQ(parse_client_request(R"({"op":"advertise","channels":[]})").kind, ClientRequest::Kind::kRefused);
+  const auto adv = parse_client_request(
+      R"({"op":"advertise","channels":[{"id":7,"topic":"/rigctl/console/command","encoding":"json","schemaName":"c"}]})");
+  ASSERT_EQ(adv.kind, ClientRequest::Kind::kAdvertise);
+  ASSERT_EQ(adv.client_channels.size(), 1u);
+  EXPECT_EQ(adv.client_channels[0].id, 7u);
+  EXPECT_EQ(adv.client_channels[0].topic, "/rigctl/console/command");
+  EXPECT_EQ(parse_client_request(R"({"op":"unadvertise","channelIds":[7]})").unadvertised, std::vector<uint32_t>{7});
+  // A channel without its topic is unreadable, not a crash.
+  EXPECT_EQ(parse_client_request(R"({"op":"advertise","channels":[{"id":7}]})").kind, ClientRequest::Kind::kUnknown);
+  EXPECT_EQ(parse_client_request(R"({"op":"fetchAsset","uri":"x"})").kind, ClientRequest::Kind::kRefused);
   const auto garbage = parse_client_request("{not json");
   EXPECT_EQ(garbage.kind, ClientRequest::Kind::kUnknown);
   EXPECT_FALSE(garbage.error.empty());
+}
+
+TEST(Protocol, ClientMessageDataIsChannelThenPayload) {
+  const std::string frame = std::string("\x01\x07\x00\x00\x00", 5) + R"({"a":1})";
+  const auto m = parse_client_message_data(frame);
+  ASSERT_TRUE(m.has_value());
+  EXPECT_EQ(m->channel, 7u);
+  EXPECT_EQ(m->payload, R"({"a":1})");
+  EXPECT_FALSE(parse_client_message_data(std::string("\x01\x07\x00", 3)).has_value());  // too short for the id
+  EXPECT_FALSE(parse_client_message_data(std::string("\x02\x07\x00\x00\x00", 5)).has_value());  // another opcode
+  const auto info = nlohmann::json::parse(server_info_json("rigctl", {}, "s1", /*client_publish=*/true));
+  EXPECT_EQ(info["capabilities"], nlohmann::json::array({"parameters", "clientPublish"}));
+  EXPECT_EQ(info["supportedEncodings"], nlohmann::json::array({"json"}));
 }
 
 TEST(Protocol, ServerMessagesCarryWhatClientsRead) {
