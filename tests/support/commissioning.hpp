@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "config/config_reader.hpp"
@@ -23,6 +24,13 @@ inline std::string commissioning_dir(const std::string& name) {
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir.string();
+}
+
+// A config written into a test's folder; returns its path.
+inline std::string write_config(const std::string& dir, const std::string& name, const std::string& text) {
+  const std::string path = dir + "/" + name;
+  std::ofstream(path) << text;
+  return path;
 }
 
 inline ProcessResult rigctl(const std::string& args) { return run_command(std::string(RIGCTL_BINARY) + " " + args); }

@@ -6,7 +6,6 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <numbers>
 
 #include "commissioning.hpp"
@@ -18,17 +17,12 @@ namespace rigctl {
 namespace {
 
 using test::rigctl;
+using test::write_config;
 
 const std::string kConfig = std::string(RIGCTL_SOURCE_DIR) + "/config/quarter_car.yaml";
 // A conservative proportional stabiliser: the crossover near 0.6 Hz, far
 // below what the rig can do; the "no gains yet" start of commissioning.
 constexpr double kStabiliser = 20.0;
-
-std::string write_config(const std::string& dir, const std::string& name, const std::string& text) {
-  const std::string path = dir + "/" + name;
-  std::ofstream(path) << text;
-  return path;
-}
 
 // identify -> tune, from the stabiliser; returns the tuned config's path.
 std::string identify_and_tune(const std::string& config, const std::string& dir, const std::string& tag) {
