@@ -20,6 +20,7 @@ struct Residuals {
   std::vector<int> free_index;
   std::vector<int> prior_index;  // free parameters with a prior (one residual each, after the data)
   std::size_t count = 0;
+  std::size_t horizon = 0;  // replays stop after the last masked sample (RigModel::simulate_prefix)
 
   void theta_from(const double* z, std::vector<double>& theta) const {
     theta = p->theta0;
@@ -33,7 +34,7 @@ struct Residuals {
     std::vector<double> theta;
     theta_from(z, theta);
     std::vector<std::vector<double>> y;
-    p->model->simulate(theta, y);
+    p->model->simulate_prefix(theta, y, horizon);
     const auto& outs = p->model->outputs();
     std::size_t k = 0;
     for (std::size_t o = 0; o < outs.size(); ++o) {
@@ -145,10 +146,17 @@ double effective_fraction(const std::vector<double>& r) {
   return 1.0 / (1.0 + 2.0 * sum);
 }
 
+// One past the last sample a fit scores: its replays need go no further.
+std::size_t mask_horizon(const std::vector<unsigned char>& mask) {
+  std::size_t h = mask.size();
+  while (h > 0 && !mask[h - 1]) --h;
+  return h;
+}
+
 double weighted_sse(const RigModel& model, const std::vector<double>& theta, const std::vector<unsigned char>& mask,
                     const std::vector<double>& weight) {
   std::vector<std::vector<double>> y;
-  model.simulate(theta, y);
+  model.simulate_prefix(theta, y, mask_horizon(mask));
   double s = 0.0;
   const auto& outs = model.outputs();
   for (std::size_t o = 0; o < outs.size(); ++o)
@@ -172,6 +180,7 @@ FitResult fit_output_error(const FitProblem& p, bool with_covariance) {
   std::size_t masked = 0;
   for (auto m : p.mask) masked += m ? 1 : 0;
   res->count = masked * p.model->outputs().size() + res->prior_index.size();
+  res->horizon = mask_horizon(p.mask);
 
   FitResult out;
   out.theta = p.theta0;
@@ -228,7 +237,7 @@ FitResult fit_output_error(const FitProblem& p, bool with_covariance) {
 
   // Residual variance and colour for the covariance scaling.
   std::vector<std::vector<double>> y;
-  p.model->simulate(out.theta, y);
+  p.model->simulate_prefix(out.theta, y, res->horizon);
   std::vector<double> r;
   const auto& m0 = p.model->outputs()[0].measured;
   for (std::size_t i = 0; i < m0.size(); ++i)
