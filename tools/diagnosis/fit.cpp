@@ -9,7 +9,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <thread>
+#include <mutex>
+
+#include "tools/diagnosis/parallel.hpp"
 
 namespace rigctl::diag {
 
@@ -76,8 +78,6 @@ class SimCost : public ceres::CostFunction {
     r_->eval(params[0], residuals);
     if (jacobians == nullptr || jacobians[0] == nullptr) return true;
     const std::size_t m = r_->count;
-    // The columns' simulations are independent: they run on two threads
-    // (the simulations are const and share nothing).
     auto column = [&](std::size_t j, std::vector<double>& rp, std::vector<double>& rm) {
       std::vector<double> z(params[0], params[0] + nf);
       const double h = 1e-4 * std::max(std::abs(z[j]), 0.05);
@@ -103,15 +103,11 @@ class SimCost : public ceres::CostFunction {
       const double d = a - b;
       for (std::size_t i = 0; i < m; ++i) jacobians[0][i * nf + j] = d > 0 ? (fa[i] - fb[i]) / d : 0.0;
     };
-    std::thread helper([&] {
-      std::vector<double> rp(m), rm(m);
-      for (std::size_t j = 1; j < nf; j += 2) column(j, rp, rm);
-    });
-    {
-      std::vector<double> rp(m), rm(m);
-      for (std::size_t j = 0; j < nf; j += 2) column(j, rp, rm);
-    }
-    helper.join();
+    // The columns' simulations are independent: they run on the workers
+    // (the simulations are const and share nothing), each with its own
+    // buffers.
+    std::vector<std::vector<double>> rp(kDiagnosisWorkers, std::vector<double>(m)), rm = rp;
+    parallel_for(nf, [&](std::size_t j, std::size_t worker) { column(j, rp[worker], rm[worker]); });
     return true;
   }
 
@@ -207,7 +203,10 @@ FitResult fit_output_error(const FitProblem& p, bool with_covariance) {
     zhi[j] = sp.hi < 1e29 ? sp.hi / sp.scale : 1e30;
   }
   auto* cost = new SimCost(res, zlo, zhi);
-  FLAGS_minloglevel = 3;  // Ceres logs through glog: keep the terminal for our progress
+  // Ceres logs through glog: keep the terminal for our progress (once: fits
+  // run on several threads).
+  static std::once_flag quiet;
+  std::call_once(quiet, [] { FLAGS_minloglevel = 3; });
   ceres::Problem::Options popt;
   popt.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem problem(popt);
