@@ -14,6 +14,7 @@
 
 #include "tools/diagnosis/criteria.hpp"
 #include "tools/diagnosis/evidence.hpp"
+#include "tools/diagnosis/parallel.hpp"
 #include "tools/diagnosis/workspace.hpp"
 
 namespace rigctl::diag {
@@ -114,22 +115,27 @@ Scored fit_coupled(const Workspace& w, const std::vector<double>& start, const s
 // Screening: a short refit per start of the effect's grid, the baseline's
 // parameters free too (they may have bent to mimic the missing effect),
 // effects already kept held where the current fit put them. Best first.
+// The candidates are independent: they are screened side by side on the
+// workers (parallel.hpp), which keeps both cores busy through the parts of
+// a fit that are not its Jacobian.
 std::vector<Candidate> screen(const Workspace& w, const Scored& current, const std::vector<std::size_t>& active,
                               int round) {
-  std::vector<Candidate> out;
-  for (std::size_t e = 0; e < w.effects.size(); ++e) {
-    if (w.effects[e].stub || std::find(active.begin(), active.end(), e) != active.end()) continue;
+  std::vector<std::size_t> todo;
+  for (std::size_t e = 0; e < w.effects.size(); ++e)
+    if (!w.effects[e].stub && std::find(active.begin(), active.end(), e) == active.end()) todo.push_back(e);
+  std::vector<Candidate> out(todo.size());
+  parallel_for(todo.size(), [&](std::size_t k, std::size_t) {
+    const std::size_t e = todo[k];
     w.say("round " + std::to_string(round) + ": screening " + w.effects[e].cause);
     std::vector<bool> free = coupled_free(w, {e});
-    Candidate best;
+    Candidate& best = out[k];
     best.effect = e;
     best.s.est_sse = std::numeric_limits<double>::infinity();
     for (const auto& s : starts_of(w, e, current.theta)) {
       auto r = w.fit(s, free, kScreeningIterations, false);
       if (r.est_sse < best.s.est_sse) best.s = std::move(r);
     }
-    out.push_back(std::move(best));
-  }
+  });
   std::sort(out.begin(), out.end(), [](const Candidate& a, const Candidate& b) { return a.s.est_sse < b.s.est_sse; });
   return out;
 }
@@ -143,48 +149,59 @@ bool strength_significant(const Workspace& w, std::size_t e, const Scored& s) {
   return false;
 }
 
-// Full refit of the best few, each judged against the current model.
+// Full refit of one screened candidate, judged against the current model
+// (every candidate of the round at the same N_eff, neff).
+Candidate refit_one(const Workspace& w, const Candidate& screened, const Scored& current,
+                    const std::vector<std::size_t>& active, double neff, int round) {
+  Candidate r;
+  r.effect = screened.effect;
+  const std::string& cause = w.effects[r.effect].cause;
+  w.say("round " + std::to_string(round) + ": refitting " + cause);
+  auto act = active;
+  act.push_back(r.effect);
+  // The baseline parameters the kept and the new effects couple to are
+  // free; the others stay where the calibration put them (their
+  // sub-model's outputs do not change with the candidate).
+  r.s = fit_coupled(w, screened.s.theta, act, 30, current);
+  w.say("  " + cause + ": refitted in " + std::to_string(r.s.iterations) + " iterations");
+  r.gain = -1e9;
+  for (std::size_t o = 0; o < w.outs().size(); ++o)
+    if (r.s.fit[o] - current.fit[o] > r.gain) r.gain = r.s.fit[o] - current.fit[o], r.signal = o;
+  const auto fits = bootstrap_fits(w.outs()[r.signal].measured, {&current.y[r.signal], &r.s.y[r.signal]},
+                                   w.val_begin, w.n, 200, 777);
+  r.se = gain_standard_error(fits, 1, 0);
+  CandidateEvidence ev{r.gain, r.se, strength_significant(w, r.effect, r.s),
+                       bic(r.s.est_sse, w.parameter_count(act), neff, w.n_est_values),
+                       bic(current.est_sse, w.parameter_count(active), neff, w.n_est_values)};
+  r.reason = rejection(ev, w.options);
+  return r;
+}
+
+// Full refit of the best few, side by side on the workers (they are
+// independent), each judged against the current model; the screening
+// record in screening order.
 std::vector<Candidate> refit_best(const Workspace& w, std::vector<Candidate> screened, const Scored& current,
                                   const std::vector<std::size_t>& active, int round, Diagnosis& d) {
-  std::vector<Candidate> refits;
   const double neff = w.n_eff(current);  // every candidate of the round is compared at this one
+  const std::size_t top = std::min(screened.size(), static_cast<std::size_t>(std::max(0, w.options.refit_top)));
+  std::vector<Candidate> refits(top);
+  parallel_for(top, [&](std::size_t c, std::size_t) { refits[c] = refit_one(w, screened[c], current, active, neff, round); });
   for (std::size_t c = 0; c < screened.size(); ++c) {
     ScreenedCandidate sc;
     sc.cause = w.effects[screened[c].effect].cause;
     sc.round = round;
     sc.estimation_cost = screened[c].s.est_sse;
-    if (static_cast<int>(c) >= w.options.refit_top) {
+    if (c >= top) {
       sc.reason = "not among the best " + std::to_string(w.options.refit_top) + " in screening";
-      d.screened.push_back(sc);
-      continue;
+    } else {
+      const Candidate& r = refits[c];
+      sc.refitted = true;
+      sc.gain_percent_points = r.gain;
+      sc.signal = w.outs()[r.signal].name;
+      sc.reason = r.reason.empty() ? "passes" : r.reason;
+      w.say("  " + sc.cause + ": gain " + fmt(r.gain, 3) + " pp on " + sc.signal + " (" + sc.reason + ")");
     }
-    Candidate r;
-    r.effect = screened[c].effect;
-    w.say("round " + std::to_string(round) + ": refitting " + sc.cause);
-    auto act = active;
-    act.push_back(r.effect);
-    // The baseline parameters the kept and the new effects couple to are
-    // free; the others stay where the calibration put them (their
-    // sub-model's outputs do not change with the candidate).
-    r.s = fit_coupled(w, screened[c].s.theta, act, 30, current);
-    w.say("  " + sc.cause + ": refitted in " + std::to_string(r.s.iterations) + " iterations");
-    r.gain = -1e9;
-    for (std::size_t o = 0; o < w.outs().size(); ++o)
-      if (r.s.fit[o] - current.fit[o] > r.gain) r.gain = r.s.fit[o] - current.fit[o], r.signal = o;
-    const auto fits = bootstrap_fits(w.outs()[r.signal].measured, {&current.y[r.signal], &r.s.y[r.signal]},
-                                     w.val_begin, w.n, 200, 777);
-    r.se = gain_standard_error(fits, 1, 0);
-    CandidateEvidence ev{r.gain, r.se, strength_significant(w, r.effect, r.s),
-                         bic(r.s.est_sse, w.parameter_count(act), neff, w.n_est_values),
-                         bic(current.est_sse, w.parameter_count(active), neff, w.n_est_values)};
-    r.reason = rejection(ev, w.options);
-    sc.refitted = true;
-    sc.gain_percent_points = r.gain;
-    sc.signal = w.outs()[r.signal].name;
-    sc.reason = r.reason.empty() ? "passes" : r.reason;
-    w.say("  " + sc.cause + ": gain " + fmt(r.gain, 3) + " pp on " + sc.signal + " (" + sc.reason + ")");
     d.screened.push_back(sc);
-    refits.push_back(std::move(r));
   }
   return refits;
 }

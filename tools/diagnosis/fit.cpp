@@ -9,7 +9,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <thread>
+#include <mutex>
+
+#include "tools/diagnosis/parallel.hpp"
 
 namespace rigctl::diag {
 
@@ -20,6 +22,7 @@ struct Residuals {
   std::vector<int> free_index;
   std::vector<int> prior_index;  // free parameters with a prior (one residual each, after the data)
   std::size_t count = 0;
+  std::size_t horizon = 0;  // replays stop after the last masked sample (RigModel::simulate_prefix)
 
   void theta_from(const double* z, std::vector<double>& theta) const {
     theta = p->theta0;
@@ -33,7 +36,7 @@ struct Residuals {
     std::vector<double> theta;
     theta_from(z, theta);
     std::vector<std::vector<double>> y;
-    p->model->simulate(theta, y);
+    p->model->simulate_prefix(theta, y, horizon);
     const auto& outs = p->model->outputs();
     std::size_t k = 0;
     for (std::size_t o = 0; o < outs.size(); ++o) {
@@ -52,8 +55,14 @@ struct Residuals {
   }
 };
 
-// Central differences with an explicit step per parameter (the simulation has
-// switching friction, so steps are not tiny), clipped to the bounds.
+// Finite differences with an explicit step per parameter (the simulation has
+// switching friction, so steps are not tiny), clipped to the bounds. While
+// the optimiser iterates they are forward differences: one replay per free
+// parameter instead of two, and Levenberg-Marquardt only needs a descent
+// direction (the O(h) error at h = 1e-4 of the parameter's scale is far
+// below the step it takes). The Jacobian of the covariance is central
+// (set_central before it), as before: the standard deviations feed the
+// strength test.
 class SimCost : public ceres::CostFunction {
  public:
   explicit SimCost(const Residuals* r, std::vector<double> lo, std::vector<double> hi)
@@ -61,6 +70,7 @@ class SimCost : public ceres::CostFunction {
     mutable_parameter_block_sizes()->push_back(static_cast<int>(r->free_index.size()));
     set_num_residuals(static_cast<int>(r->count));
   }
+  void set_central(bool central) { central_ = central; }
   bool Evaluate(double const* const* params, double* residuals, double** jacobians) const override {
     const std::size_t nf = r_->free_index.size();
     for (std::size_t j = 0; j < nf; ++j)
@@ -68,34 +78,43 @@ class SimCost : public ceres::CostFunction {
     r_->eval(params[0], residuals);
     if (jacobians == nullptr || jacobians[0] == nullptr) return true;
     const std::size_t m = r_->count;
-    // The 2 nf simulations of the central differences are independent: they
-    // run on two threads (the simulations are const and share nothing).
     auto column = [&](std::size_t j, std::vector<double>& rp, std::vector<double>& rm) {
       std::vector<double> z(params[0], params[0] + nf);
       const double h = 1e-4 * std::max(std::abs(z[j]), 0.05);
-      const double a = std::min(z[j] + h, hi_[j]), b = std::max(z[j] - h, lo_[j]);
-      z[j] = a;
-      r_->eval(z.data(), rp.data());
-      z[j] = b;
-      r_->eval(z.data(), rm.data());
+      double a = std::min(z[j] + h, hi_[j]), b = z[j];
+      if (central_) {
+        b = std::max(z[j] - h, lo_[j]);
+      } else if (a <= z[j]) {  // at the upper bound: a backward difference
+        a = z[j];
+        b = std::max(z[j] - h, lo_[j]);
+      }
+      const double* fa = residuals;
+      const double* fb = residuals;
+      if (a != z[j]) {
+        z[j] = a;
+        r_->eval(z.data(), rp.data());
+        fa = rp.data();
+      }
+      if (b != params[0][j]) {
+        z[j] = b;
+        r_->eval(z.data(), rm.data());
+        fb = rm.data();
+      }
       const double d = a - b;
-      for (std::size_t i = 0; i < m; ++i) jacobians[0][i * nf + j] = d > 0 ? (rp[i] - rm[i]) / d : 0.0;
+      for (std::size_t i = 0; i < m; ++i) jacobians[0][i * nf + j] = d > 0 ? (fa[i] - fb[i]) / d : 0.0;
     };
-    std::thread helper([&] {
-      std::vector<double> rp(m), rm(m);
-      for (std::size_t j = 1; j < nf; j += 2) column(j, rp, rm);
-    });
-    {
-      std::vector<double> rp(m), rm(m);
-      for (std::size_t j = 0; j < nf; j += 2) column(j, rp, rm);
-    }
-    helper.join();
+    // The columns' simulations are independent: they run on the workers
+    // (the simulations are const and share nothing), each with its own
+    // buffers.
+    std::vector<std::vector<double>> rp(kDiagnosisWorkers, std::vector<double>(m)), rm = rp;
+    parallel_for(nf, [&](std::size_t j, std::size_t worker) { column(j, rp[worker], rm[worker]); });
     return true;
   }
 
  private:
   const Residuals* r_;
   std::vector<double> lo_, hi_;
+  bool central_ = false;
 };
 
 }  // namespace
@@ -123,10 +142,17 @@ double effective_fraction(const std::vector<double>& r) {
   return 1.0 / (1.0 + 2.0 * sum);
 }
 
+// One past the last sample a fit scores: its replays need go no further.
+std::size_t mask_horizon(const std::vector<unsigned char>& mask) {
+  std::size_t h = mask.size();
+  while (h > 0 && !mask[h - 1]) --h;
+  return h;
+}
+
 double weighted_sse(const RigModel& model, const std::vector<double>& theta, const std::vector<unsigned char>& mask,
                     const std::vector<double>& weight) {
   std::vector<std::vector<double>> y;
-  model.simulate(theta, y);
+  model.simulate_prefix(theta, y, mask_horizon(mask));
   double s = 0.0;
   const auto& outs = model.outputs();
   for (std::size_t o = 0; o < outs.size(); ++o)
@@ -150,6 +176,7 @@ FitResult fit_output_error(const FitProblem& p, bool with_covariance) {
   std::size_t masked = 0;
   for (auto m : p.mask) masked += m ? 1 : 0;
   res->count = masked * p.model->outputs().size() + res->prior_index.size();
+  res->horizon = mask_horizon(p.mask);
 
   FitResult out;
   out.theta = p.theta0;
@@ -176,7 +203,10 @@ FitResult fit_output_error(const FitProblem& p, bool with_covariance) {
     zhi[j] = sp.hi < 1e29 ? sp.hi / sp.scale : 1e30;
   }
   auto* cost = new SimCost(res, zlo, zhi);
-  FLAGS_minloglevel = 3;  // Ceres logs through glog: keep the terminal for our progress
+  // Ceres logs through glog: keep the terminal for our progress (once: fits
+  // run on several threads).
+  static std::once_flag quiet;
+  std::call_once(quiet, [] { FLAGS_minloglevel = 3; });
   ceres::Problem::Options popt;
   popt.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem problem(popt);
@@ -206,7 +236,7 @@ FitResult fit_output_error(const FitProblem& p, bool with_covariance) {
 
   // Residual variance and colour for the covariance scaling.
   std::vector<std::vector<double>> y;
-  p.model->simulate(out.theta, y);
+  p.model->simulate_prefix(out.theta, y, res->horizon);
   std::vector<double> r;
   const auto& m0 = p.model->outputs()[0].measured;
   for (std::size_t i = 0; i < m0.size(); ++i)
@@ -226,6 +256,7 @@ FitResult fit_output_error(const FitProblem& p, bool with_covariance) {
   // directions with eigenvalues below 1e-10 of the largest are not identifiable.
   double cost_now = 0.0;
   ceres::CRSMatrix J;
+  cost->set_central(true);
   problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost_now, nullptr, nullptr, &J);
   Eigen::MatrixXd JtJ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(nf), static_cast<Eigen::Index>(nf));
   for (int row = 0; row < J.num_rows; ++row)

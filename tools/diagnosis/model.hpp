@@ -58,6 +58,15 @@ class RigModel {
   // theta: baseline parameters then every effect's, in effects() order.
   // y: one vector per output, each time().size() long.
   virtual void simulate(const std::vector<double>& theta, std::vector<std::vector<double>>& y) const = 0;
+  // The same replay over the first `samples` samples only; the rest of each
+  // output is left unspecified. A fit scores only the estimation part (the
+  // first 80 % of the record), so its replays can stop there: the replays
+  // are causal, so those samples are the same as the whole record's. The
+  // default replays the whole record.
+  virtual void simulate_prefix(const std::vector<double>& theta, std::vector<std::vector<double>>& y,
+                               std::size_t /*samples*/) const {
+    simulate(theta, y);
+  }
   // Whether baseline parameter `index` can change the outputs an effect of
   // `cause` acts on: the screening frees only those (a rig of sub-models
   // screens a sub-model's effect without replaying the others).

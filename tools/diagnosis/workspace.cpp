@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
+#include <mutex>
 
 #include "tools/diagnosis/criteria.hpp"
 #include "tools/diagnosis/fit.hpp"
@@ -108,6 +109,8 @@ double Workspace::residual_variance(const Scored& s) const {
 
 void Workspace::say(const std::string& m) const {
   if (!options.progress) return;
+  static std::mutex one_line_at_a_time;  // candidates are fitted on several threads
+  std::lock_guard<std::mutex> lock(one_line_at_a_time);
   const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count();
   *options.progress << "diagnose [" << std::fixed << std::setprecision(1) << t << std::defaultfloat << " s] " << m
                     << std::endl;

@@ -69,8 +69,15 @@ std::vector<double> key(const std::vector<double>& th, const std::size_t (&idx)[
   return k;
 }
 
-// A few recent sub-model replays by parameter values (thread-safe: the
-// fit's central differences run on two threads).
+// Recent sub-model replays by parameter values (thread-safe: the fit's
+// Jacobian columns run on two threads). A Jacobian column that moves an
+// actuator parameter needs the suspension replay of the column's base point,
+// and the other way round; the base must still be here after the columns
+// before it have added theirs. With 4 entries it was not (a round-2 refit
+// moves 20 parameters): the quarter car replayed the actuator 8252 times in
+// one diagnosis instead of 4914. kCapacity covers the central differences
+// of the largest fit (2 x ~24 columns) and the trial points around them;
+// at 6649 samples an entry is 0.1-0.2 MB, so the cache stays under 15 MB.
 class ReplayCache {
  public:
   bool find(const std::vector<double>& key, std::vector<std::vector<double>>& out) const {
@@ -87,10 +94,11 @@ class ReplayCache {
   void put(std::vector<double> key, std::vector<std::vector<double>> y) const {
     std::lock_guard<std::mutex> lock(m_);
     entries_.emplace(entries_.begin(), std::move(key), std::move(y));
-    if (entries_.size() > 4) entries_.pop_back();
+    if (entries_.size() > kCapacity) entries_.pop_back();
   }
 
  private:
+  static constexpr std::size_t kCapacity = 64;
   mutable std::mutex m_;
   mutable std::vector<std::pair<std::vector<double>, std::vector<std::vector<double>>>> entries_;
 };
@@ -187,20 +195,27 @@ class QuarterCarModel : public RigModel {
   // sub-model's parameters (a column of the central differences, say) takes
   // the other's outputs from a small cache instead of replaying it again.
   void simulate(const std::vector<double>& th, std::vector<std::vector<double>>& y) const override {
+    simulate_prefix(th, y, t_.size());
+  }
+  void simulate_prefix(const std::vector<double>& th, std::vector<std::vector<double>>& y,
+                       std::size_t samples) const override {
+    samples = std::min(samples, t_.size());
     y.assign(outputs_.size(), std::vector<double>(t_.size()));
-    const std::vector<double> ks = key(th, kSuspensionParams), ka = key(th, kActuatorParams);
+    std::vector<double> ks = key(th, kSuspensionParams), ka = key(th, kActuatorParams);
+    ks.push_back(static_cast<double>(samples));  // a prefix is not the whole replay
+    ka.push_back(static_cast<double>(samples));
     std::vector<std::vector<double>> part;
     if (susp_cache_.find(ks, part)) {
       y[0] = std::move(part[0]);
       y[1] = std::move(part[1]);
     } else {
-      simulate_suspension(th, y[0], y[1]);
+      simulate_suspension(th, y[0], y[1], samples);
       susp_cache_.put(ks, {y[0], y[1]});
     }
     if (act_cache_.find(ka, part)) {
       for (std::size_t o = 2; o < y.size(); ++o) y[o] = std::move(part[o - 2]);
     } else {
-      simulate_actuator(th, y);
+      simulate_actuator(th, y, samples);
       act_cache_.put(ka, std::vector<std::vector<double>>(y.begin() + 2, y.end()));
     }
   }
@@ -237,7 +252,8 @@ class QuarterCarModel : public RigModel {
   }
 
  private:
-  void simulate_suspension(const std::vector<double>& th, std::vector<double>& yb, std::vector<double>& yw) const {
+  void simulate_suspension(const std::vector<double>& th, std::vector<double>& yb, std::vector<double>& yw,
+                           std::size_t samples) const {
     const double ks = th[kKs], bd = th[kBd], Fc = th[kFc], dFs = th[kDFs], D = th[kD], mu = th[kMu], dc = th[kDc],
                  tau = th[kTau], b_b = th[kBb], b_w = th[kBw], uni = th[kUni];
     const std::size_t n = t_.size();
@@ -248,7 +264,7 @@ class QuarterCarModel : public RigModel {
     const bool friction = Fc > 0.0 || dFs > 0.0 || D > 0.0 || mu > 0.0;
     const BearingFrictionParams bp = p_.bearing_friction;
     double xw = xw_[0], xb = outputs_[0].measured[0], vw = vw_[0], vb = friction ? 0.0 : vb_[0];
-    for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t i = 0; i < samples; ++i) {
       yb[i] = xb + b_b;
       yw[i] = xw + b_w;
       const double xr0 = xr_[i], xr1 = i + 1 < n ? xr_[i + 1] : xr_[i];
@@ -311,7 +327,8 @@ class QuarterCarModel : public RigModel {
     d.vr = (a.p1 * a1 - a.p2 * a2 - th[kBvr] * a.vr - f_tyre - p.mass_rod * p.gravity - seal) / p.mass_rod;
   }
 
-  void simulate_actuator(const std::vector<double>& th, std::vector<std::vector<double>>& y) const {
+  void simulate_actuator(const std::vector<double>& th, std::vector<std::vector<double>>& y,
+                         std::size_t samples) const {
     const std::size_t n = t_.size();
     const bool pressures = outputs_.size() > 4;
     PiController pi(pi_);
@@ -336,7 +353,7 @@ class QuarterCarModel : public RigModel {
     auto axpy = [](const Act& x, double k, const Act& d) {
       return Act{x.xs + k * d.xs, x.p1 + k * d.p1, x.p2 + k * d.p2, x.xr + k * d.xr, x.vr + k * d.vr};
     };
-    for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t i = 0; i < samples; ++i) {
       s.value[0] = a.xr;
       pi.update(xref_[i], s, c, terms);
       const double u = std::clamp(c.value[0], -1.0, 1.0);
