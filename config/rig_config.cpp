@@ -68,6 +68,9 @@ PiConfig read_pi(ConfigReader& r, double period_s) {
   PiConfig pi;
   pi.kp = r.number("kp", 0.0, 1e6);
   pi.ki = r.number("ki", 0.0, 1e6);
+  // Optional: a tuned config has it (`rigctl tune`); 1e3 s/m would open the
+  // valve fully for 1 mm/s, beyond any rig.
+  if (r.has("velocity_feedforward")) pi.velocity_feedforward = r.number("velocity_feedforward", 0.0, 1e3);
   pi.output_limit = r.number("output_limit", 1e-6, 1e6);
   pi.anti_windup = r.choice("anti_windup", {"conditional", "none"}) == "none" ? AntiWindup::kNone
                                                                             : AntiWindup::kConditional;

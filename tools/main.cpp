@@ -214,6 +214,7 @@ int main(int argc, char** argv) {
   tune_cmd->add_option("--method", tune_method, "frf: loop shaping on the FRF; relay: Astrom-Hagglund relay experiment, Ziegler-Nichols gains")->check(CLI::IsMember({"frf", "relay"}));
   tune_cmd->add_option("--phase-margin", tune.target.phase_margin_deg, "Target phase margin [deg]")->capture_default_str()->check(CLI::Range(10.0, 89.0));
   auto* bw_opt = tune_cmd->add_option("--bandwidth", tune_bandwidth, "Target crossover frequency [Hz] (default: the stiffest design with 6 dB gain margin and sensitivity peak 2)")->check(CLI::PositiveNumber);
+  tune_cmd->add_flag("--no-feedforward{false}", tune.feedforward, "PI: no velocity feedforward of the demand (by default it is 1 / the measured plant's velocity gain)");
   tune_cmd->add_option("--out", tune.out_path, "Write the config with the tuned gains (YAML, comments kept)");
   tune_cmd->add_option("--json", tune.json_path, "Write the design and its predictions (JSON)");
   tune_cmd->add_option("--plot", tune.plot_path, "Bode plot of the measured plant and the tuned loop (PNG)");

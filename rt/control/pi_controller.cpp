@@ -8,6 +8,8 @@ namespace rigctl {
 PiController::PiController(const PiConfig& config) : config_(config) {
   if (config.period_s <= 0.0) throw std::invalid_argument("PI period must be positive");
   if (config.output_limit <= 0.0) throw std::invalid_argument("PI output limit must be positive");
+  if (config.velocity_feedforward < 0.0) throw std::invalid_argument("PI velocity feedforward must not be negative");
+  if (config.velocity_feedforward > 0.0) term_names_.push_back("ff");
 }
 
 void PiController::update(double setpoint, const Sample& sample, Command& command,
@@ -17,8 +19,13 @@ void PiController::update(double setpoint, const Sample& sample, Command& comman
   const double limit = config_.output_limit;
 
   const double p = config_.kp * error;
+  const double ff = has_previous_setpoint_
+                        ? config_.velocity_feedforward * (setpoint - previous_setpoint_) / config_.period_s
+                        : 0.0;
+  previous_setpoint_ = setpoint;
+  has_previous_setpoint_ = true;
   const double candidate = integrator_ + config_.ki * config_.period_s * error;
-  const double unsat_with_candidate = p + candidate;
+  const double unsat_with_candidate = p + ff + candidate;
   // The valve is not following (the driver says so): the error does not
   // answer the command, and integrating it would wind up whatever the valve
   // takes once it follows again.
@@ -32,7 +39,7 @@ void PiController::update(double setpoint, const Sample& sample, Command& comman
   } else {
     integrator_ = candidate;
   }
-  const double unsaturated = p + integrator_;
+  const double unsaturated = p + ff + integrator_;
   const double output = std::clamp(unsaturated, -limit, limit);
 
   command.value[static_cast<std::size_t>(config_.output_index)] = output;
@@ -41,6 +48,7 @@ void PiController::update(double setpoint, const Sample& sample, Command& comman
   terms.error = error;
   terms.term[0] = p;
   terms.term[1] = integrator_;
+  terms.term[2] = ff;  // published only when "ff" is among the term names
   terms.output_unsaturated = unsaturated;
   terms.output = output;
   terms.saturated = unsaturated != output;

@@ -70,6 +70,10 @@ IdentifyPlan plan_identification(RigConfig config, const IdentifySettings& s) {
                       std::string(to_string(kind)));
   }
   if (s.stabiliser_gain) use_stabiliser(config.controller, *s.stabiliser_gain);
+  // The feedback loop is what is measured: a demand feedforward would add a
+  // path around it, and the closed loop would no longer be L / (1 + L)
+  // (the margins read from it as T / (1 - T) would be wrong).
+  config.controller.pi.velocity_feedforward = 0.0;
   every_trip_interlocks(config.safety);
   const IdentifyConfig& ic = config.identify;
 

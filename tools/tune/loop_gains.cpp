@@ -12,6 +12,7 @@ LoopGains LoopGains::from_config(const RigConfig& c) {
     case ControllerKind::kPi:
       g.kp = c.controller.pi.kp;
       g.ki = c.controller.pi.ki;
+      g.kff = c.controller.pi.velocity_feedforward;
       g.output_limit = c.controller.pi.output_limit;
       return g;
     case ControllerKind::kPvp: {
@@ -34,7 +35,7 @@ LoopGains LoopGains::from_config(const RigConfig& c) {
 }
 
 std::map<std::string, double> LoopGains::config_values() const {
-  if (kind == ControllerKind::kPi) return {{"kp", kp}, {"ki", ki}};
+  if (kind == ControllerKind::kPi) return {{"kp", kp}, {"ki", ki}, {"velocity_feedforward", kff}};
   return {{"ke", ke}, {"kv", kv}, {"kp_v_per_bar", kp_pressure * 1e5}};
 }
 
@@ -42,6 +43,7 @@ void LoopGains::apply_to(ControllerConfig& c) const {
   if (kind == ControllerKind::kPi) {
     c.pi.kp = kp;
     c.pi.ki = ki;
+    c.pi.velocity_feedforward = kff;
   } else {
     c.pvp.ke = ke;
     c.pvp.kv = kv;

@@ -14,8 +14,9 @@ struct LoopGains {
   ControllerKind kind = ControllerKind::kPi;
   double period_s = 0.0025;
   double output_limit = 1.0;
-  // PI: u = kp e + ki sum(e) Ts
-  double kp = 0.0, ki = 0.0;
+  // PI: u = kp e + ki sum(e) Ts + kff dr/dt (the feedforward is outside the
+  // loop: it changes the step, not the margins)
+  double kp = 0.0, ki = 0.0, kff = 0.0;
   // P+V+dP: u = Ke e - Kp dp - Kv omega (Kp in V/Pa here, V/bar in the config)
   double ke = 0.0, kv = 0.0, kp_pressure = 0.0;
   bool transient_pressure = false;

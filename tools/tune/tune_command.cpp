@@ -64,6 +64,16 @@ PlantModel design_on_frf(const FrfData& frf, const RigConfig& config, const Loop
   }
   result.margins = margins_of(grid, result.gains);
   PlantModel model = fit_plant(plant, config.loop.period_s);
+  if (o.method == TuneMethod::kFrf) {
+    FeedforwardDesign ff;
+    if (o.feedforward) {
+      ff = design_feedforward(plant, result.margins->crossover_hz, config);
+    } else {
+      ff.reason_for_none = "--no-feedforward";
+    }
+    result.gains.kff = ff.kff;
+    result.feedforward = ff;
+  }
   if (config.profile.type == ProfileKind::kRampSteps) {
     result.step = predict_step(model, result.gains, config, frf.operating_point.command_mean);
   }

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "config/kind_names.hpp"
+#include "tools/tune/feedforward.hpp"
 #include "tools/tune/loop_design.hpp"
 #include "tools/tune/step_prediction.hpp"
 
@@ -55,6 +56,7 @@ struct TuneOptions {
   std::string evaluate_path;  // a run file of the config's standard step: its metrics, no design
   TuneMethod method = TuneMethod::kFrf;
   DesignTarget target;
+  bool feedforward = true;  // PI: the demand's velocity feedforward from the FRF (--no-feedforward: PI alone)
   RelayOptions relay;
 };
 
@@ -63,6 +65,7 @@ struct TuneResult {
   std::optional<Margins> margins;          // predicted on the measured plant (FRF method)
   std::optional<Margins> present_margins;  // of the gains the FRF was measured with
   std::optional<StepPrediction> step;      // predicted standard step
+  std::optional<FeedforwardDesign> feedforward;  // FRF method
   std::string note;
 };
 

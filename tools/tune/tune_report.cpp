@@ -63,6 +63,16 @@ void print_tune(const TuneReportInput& in, std::ostream& out) {
   out << "\n  gains:";
   for (const auto& [k, v] : r.gains.config_values()) out << " " << k << " " << v;
   out << "\n";
+  if (r.feedforward) {
+    const FeedforwardDesign& f = *r.feedforward;
+    if (f.kff > 0.0) {
+      out << "  velocity feedforward " << f.kff << " s per unit of feedback: 1 / the plant's velocity gain " << f.velocity_gain
+          << " per second per unit command (|G| w, median over " << f.band_low_hz << "-" << f.band_high_hz
+          << " Hz); outside the loop, so the margins are the PI's\n";
+    } else {
+      out << "  no velocity feedforward: " << f.reason_for_none << "\n";
+    }
+  }
   if (r.margins) print_margins("predicted (tuned gains on the measured plant)", *r.margins, out);
   if (r.step) {
     const auto& m = r.step->metrics;
@@ -92,6 +102,11 @@ void write_tune_json(const TuneReportInput& in, const std::string& path) {
     first = false;
   }
   o << "}";
+  if (r.feedforward) {
+    o << ",\n  \"feedforward\": {\"velocity_feedforward\": " << json_number(r.feedforward->kff) << ", \"velocity_gain\": "
+      << json_number(r.feedforward->velocity_gain) << ", \"band_hz\": [" << json_number(r.feedforward->band_low_hz) << ", "
+      << json_number(r.feedforward->band_high_hz) << "], \"reason_for_none\": " << json_string(r.feedforward->reason_for_none) << "}";
+  }
   if (r.present_margins) o << ",\n  \"measured_margins\": " << margins_json(*r.present_margins);
   if (r.margins) o << ",\n  \"predicted_margins\": " << margins_json(*r.margins);
   if (r.step) {

@@ -39,6 +39,7 @@ void check_loaded(const std::string& text, const std::string& name, const std::m
   for (const auto& [key, v] : values) {
     const double got = key == "kp" && c.controller.type == ControllerKind::kPi ? c.controller.pi.kp
                        : key == "ki"                                      ? c.controller.pi.ki
+                       : key == "velocity_feedforward"                    ? c.controller.pi.velocity_feedforward
                        : key == "ke"                                      ? c.controller.pvp.ke
                        : key == "kv"                                      ? c.controller.pvp.kv
                        : key == "kp_v_per_bar"                            ? c.controller.pvp.kp * 1e5

@@ -52,7 +52,8 @@ TEST(CanopenValve, LostValveHeartbeatFlagsTheInputsAfterTheTimeoutAndLatches) {
 
   Diag d(p.valve);
   EXPECT_TRUE(wait_for([&] { return d.counter("canopen_heartbeat_timeouts") == 1; }));
-  EXPECT_TRUE(d.has_event({"heartbeat lost", "timeout 1000.0 ms"})) << d.dump();
+  // The event follows the counter from the I/O thread: wait for it too.
+  EXPECT_TRUE(wait_for([&] { return d.has_event({"heartbeat lost", "timeout 1000.0 ms"}); })) << d.dump();
   EXPECT_TRUE(p.valve.faults() & CanopenValve::kFaultHeartbeatLost);
   EXPECT_NE(p.valve.flag_cause().find("canopen valve node 1: heartbeat lost"), std::string::npos) << p.valve.flag_cause();
 
@@ -206,8 +207,10 @@ TEST(CanopenValve, DroppedConnectionFlagsTheInputsWithoutCrashingAndAllowsAResta
   EXPECT_TRUE(wait_for([&] { return flagged(valve); }));
   EXPECT_TRUE(wait_for([&] { return (valve.faults() & CanopenValve::kFaultLinkLost) != 0; }));
   for (int i = 0; i < 100; ++i) valve.write_setpoint(0.3);  // the loop keeps running: no crash, no block
-  Diag d(valve);
-  EXPECT_TRUE(d.has_event({"connection lost"})) << d.dump();
+  // The I/O thread raises the fault first (the loop acts on it) and then
+  // writes the event: wait for the event rather than assume it is there.
+  Diag d(valve);  // it keeps what each look drains
+  EXPECT_TRUE(wait_for([&] { return d.has_event({"connection lost"}); })) << d.dump();
   EXPECT_EQ(d.counter("canopen_link_lost"), 1);
   EXPECT_GE(d.counter("canopen_tx_errors"), 100);
   valve.stop();
@@ -226,7 +229,8 @@ TEST(CanopenValve, ValveResetWhileOperationalIsDetected) {
   EXPECT_TRUE(wait_for([&] { return (p.valve.faults() & CanopenValve::kFaultValveReset) != 0; }));
   EXPECT_TRUE(flagged(p.valve));
   Diag d(p.valve);
-  EXPECT_TRUE(d.has_event({"valve reset"})) << d.dump();
+  // The event follows the fault from the I/O thread: wait for it too.
+  EXPECT_TRUE(wait_for([&] { return d.has_event({"valve reset"}); })) << d.dump();
   EXPECT_NE(p.valve.flag_cause().find("valve reset"), std::string::npos) << p.valve.flag_cause();
   EXPECT_EQ(d.counter("canopen_valve_resets"), 1);
 }

@@ -123,3 +123,54 @@ TEST(PiController, IntegratorIsHeldWhileTheOutputIsNotFollowing) {
   EXPECT_FALSE(t.integrator_held);
   EXPECT_DOUBLE_EQ(pi.integrator(), before + 60.0 * 0.0025 * 0.005);
 }
+
+// The integrator plant of the test above following a 0.05 m/s ramp: the PI
+// alone lags by up to speed / (kp g) until its integrator has caught up
+// (the loop is type 2, so only in the transient); with the feedforward 1 / g
+// the valve opens for the ramp's speed at once and the largest lag is the
+// one-period delay of the discrete loop. Returns the largest lag.
+double ramp_lag(double velocity_feedforward) {
+  PiConfig cfg;
+  cfg.kp = 80.0;
+  cfg.ki = 60.0;
+  cfg.period_s = 0.0025;
+  cfg.velocity_feedforward = velocity_feedforward;
+  PiController pi(cfg);
+  const double gain = 0.5, speed = 0.05;  // [m/s per unit output], [m/s]
+  double y = 0.0, lag = 0.0;
+  for (int k = 0; k < 800; ++k) {  // 2 s of ramp
+    const double r = speed * k * cfg.period_s;
+    lag = std::max(lag, r - y);
+    y += gain * run_once(pi, r, y).u * cfg.period_s;
+  }
+  return lag;
+}
+
+TEST(PiController, VelocityFeedforwardRemovesTheLagOfARamp) {
+  const double without = ramp_lag(0.0), with = ramp_lag(1.0 / 0.5);
+  EXPECT_GT(without, 0.05 * 0.0025 * 5.0) << "the PI alone lags by many periods of motion";
+  EXPECT_LE(with, 0.05 * 0.0025 * 1.01) << "at most one period's motion";
+  EXPECT_LT(with, 0.15 * without);
+}
+
+TEST(PiController, FeedforwardIsTheDemandRateAndNoneOnTheFirstTick) {
+  PiConfig cfg;
+  cfg.kp = 0.0;
+  cfg.ki = 0.0;
+  cfg.period_s = 0.0025;
+  cfg.velocity_feedforward = 2.0;  // [s/m]
+  PiController pi(cfg);
+  EXPECT_EQ(pi.term_names(), (std::vector<std::string>{"p", "i", "ff"}));
+  // A run that starts where the rod stands starts without a kick.
+  EXPECT_DOUBLE_EQ(run_once(pi, 0.080, 0.080).u, 0.0);
+  const auto a = run_once(pi, 0.080 + 0.0001, 0.080);  // 0.04 m/s
+  EXPECT_NEAR(a.terms.term[2], 2.0 * 0.04, 1e-12);
+  EXPECT_NEAR(a.u, 2.0 * 0.04, 1e-12);
+  pi.reset();
+  EXPECT_DOUBLE_EQ(run_once(pi, 0.0, 0.0).u, 0.0) << "reset forgets the previous demand";
+  // Without it the controller publishes only its two terms (run files keep their columns).
+  cfg.velocity_feedforward = 0.0;
+  EXPECT_EQ(PiController(cfg).term_names(), (std::vector<std::string>{"p", "i"}));
+  cfg.velocity_feedforward = -1.0;
+  EXPECT_THROW(PiController{cfg}, std::invalid_argument);
+}

@@ -53,6 +53,16 @@ TEST(RigConfig, OutOfRange) {
                {"plant.bearing_friction.construction_angle_deg", "got 95"});
 }
 
+// The PI's velocity feedforward is optional (a tuned config has it) and
+// checked like every gain.
+TEST(RigConfig, VelocityFeedforwardIsOptionalAndChecked) {
+  EXPECT_DOUBLE_EQ(parse_rig_config(shipped_config(), "ok.yaml").controller.pi.velocity_feedforward, 0.0);
+  const auto c = parse_rig_config(edit(shipped_config(), "  kp: 80.0", "  velocity_feedforward: 3.5\n  kp: 80.0"), "ok.yaml");
+  EXPECT_DOUBLE_EQ(c.controller.pi.velocity_feedforward, 3.5);
+  expect_config_error(edit(shipped_config(), "  kp: 80.0", "  velocity_feedforward: -1\n  kp: 80.0"),
+                      {"bad.yaml:", "controller.velocity_feedforward", "got -1"});
+}
+
 TEST(RigConfig, LineNumberPointsAtTheBadValue) {
   const std::string yaml = edit(shipped_config(), "  period_s: 0.0025", "  period_s: -1");
   expect_config_error(yaml, {"bad.yaml:" + std::to_string(test::line_of(yaml, "period_s: -1")) + ":"});
