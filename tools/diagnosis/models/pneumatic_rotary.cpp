@@ -38,7 +38,15 @@
 //    ramp with a stick/slip state (plant/bladder_hysteresis.*).
 //  * coulomb_friction: T_c tanh(omega / eps): a full jump at the reversal,
 //    flat in travel (the plant's brake is exact stick/slip).
-//  * polytropic_exponent: n scales the chamber pressure rate (null 1.4, adiabatic).
+//  * polytropic_exponent: heat exchange with the chamber walls. n scales the
+//    chamber pressure rate; slow motion leaves the gas time to exchange heat
+//    (towards isothermal, 1), fast motion does not (adiabatic, 1.4):
+//    n(omega) = n + (1.4 - n) x / sqrt(1 + x^2), x = k_h |omega|, the
+//    magnitude of a first-order thermal lag's high-pass with the rotor
+//    speed standing for the compression's rate (null n = 1.4). k_h = 0 is
+//    a constant exponent, a change of n / V, which the calibrated chamber
+//    volume V also makes: only V's prior tells the two apart; the speed
+//    dependence is a signature V has not.
 //  * valve_null_offset: u0 added to the command before the valve.
 //  * valve_deadband: overlap delta [V] of a sharp dead zone, seen through the
 //    dither average (smooth).
@@ -61,6 +69,8 @@ namespace rigctl::diag {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
+// The baseline's chamber gas: air compressed too fast to exchange heat.
+constexpr double kAdiabaticExponent = 1.4;
 
 // Smoothing speed of the sign-like torques [rad/s]. The rig's motions are
 // 0.05-1 rad/s; at 2e-3 rad/s a load pushed at 90 % of the friction level
@@ -174,9 +184,15 @@ class PneumaticRotaryModel : public RigModel {
          {P("T_c", "N m", 0.5, 0.0, 30.0, 1.0, 0.0, true)},
          "Coulomb friction T_c tanh(omega/eps) on the rotor: full jump at each reversal, flat in travel"},
         {"polytropic_exponent",
-         {P("n", "1", 1.3, 0.8, 1.8, 0.2, 1.4, true, {1.05})},
-         "polytropic exponent n of the chamber gas (pressure rate and pneumatic stiffness scale with n; 1.4 "
-         "adiabatic, 1 isothermal): heat transfer"},
+         // k_h: 1 / the rotor speed at which the compression is half-way
+         // too fast for heat exchange; 0 (a constant n, the boundary a
+         // constant-exponent gas reaches) to 50 s/rad (adiabatic above
+         // 0.02 rad/s: at any motion of the rig).
+         {P("n", "1", 1.3, 0.8, 1.8, 0.2, 1.4, true, {1.05}),
+          P("k_h", "s/rad", 2.0, 0.0, 50.0, 2.0, 2.0, false, {0.0, 10.0})},
+         "polytropic exponent of the chamber gas, n at rest rising towards 1.4 (adiabatic) with the rotor's "
+         "speed: n(omega) = n + (1.4 - n) x / sqrt(1 + x^2), x = k_h |omega| (pressure rate and pneumatic "
+         "stiffness scale with it; 1 isothermal): heat exchange with the walls"},
         {"valve_null_offset",
          {P("u0", "V", 0.05, -2.0, 2.0, 0.1, 0.0, true, {-0.1})},
          "valve null offset u0 added to the command before the spool (drift of the neutral)"},
@@ -226,26 +242,33 @@ class PneumaticRotaryModel : public RigModel {
   void run(const std::vector<double>& th, std::vector<std::vector<double>>& y, std::vector<double>* torque,
            int which = 0) const {
     const double I = th[0], b = th[1], C1 = th[2], C2 = th[3], V = th[4], Pq = th[5], alpha = th[6], dither = th[7];
-    const double hs = th[8], te = th[9], thr = std::max(th[10], 1e-4), tc = th[11], nexp = th[12], u0 = th[13],
-                 delta = th[14], tau = th[15];
+    const double hs = th[8], te = th[9], thr = std::max(th[10], 1e-4), tc = th[11], n_rest = th[12],
+                 k_h = th[13], u0 = th[14], delta = th[15], tau = th[16];
     const std::size_t N = t_.size();
     y.assign(2, std::vector<double>(N, 0.0));
     if (torque) torque->assign(N, 0.0);
     const auto& p = p_;
-    const double gas = nexp * p.gas_constant * p.supply_temperature / V;  // n R T / V
-    const double mot = nexp * Pq * alpha / V;                             // n Pq alpha / V
-    const double leak = gas * C2;                                         // 1 / tau_chamber
+    const double gas0 = p.gas_constant * p.supply_temperature / V;  // R T / V; times n
+    const double mot0 = Pq * alpha / V;                             // Pq alpha / V; times n
+    const bool speed_dependent_n = n_rest != kAdiabaticExponent;
+    auto exponent = [&](double omega) {
+      if (!speed_dependent_n) return kAdiabaticExponent;
+      const double x = k_h * omega;
+      return n_rest + (kAdiabaticExponent - n_rest) * std::abs(x) / std::sqrt(1.0 + x * x);
+    };
     const double Lv = p.spool_limit / p.solenoid_gain;
     const double A = p.dither ? dither : 0.0;
     const double A_avg = std::max(A, kMinSmoothingV);
     const double W = 2.0 * kPi * p.dither_frequency;
-    // dp ripple of a fundamental F [V] of the opening: 2 n R T/V C1 k F (a sin - W cos) / (W^2 + a^2).
-    const double ripple_gain = A > 0.0 ? 2.0 * gas * C1 * p.solenoid_gain / (W * W + leak * leak) : 0.0;
+    // dp ripple of a fundamental F [V] of the opening: 2 n R T/V C1 k F (a sin - W cos) / (W^2 + a^2),
+    // a = n R T / V C2 (1 / tau_chamber), with n at the rotor's speed.
     // At t_k - tau: the dither phase of t_k turned back by W tau.
     const double cd = std::cos(W * tau), sd = std::sin(W * tau);
-    auto ripple = [&](std::size_t k, double fundamental) {
+    auto ripple = [&](std::size_t k, double fundamental, double n) {
+      if (!(A > 0.0)) return 0.0;
+      const double gas = n * gas0, leak = gas * C2;
       const double sn = sin_[k] * cd - cos_[k] * sd, cs = cos_[k] * cd + sin_[k] * sd;
-      return ripple_gain * fundamental * (leak * sn - W * cs);
+      return 2.0 * gas * C1 * p.solenoid_gain / (W * W + leak * leak) * fundamental * (leak * sn - W * cs);
     };
     auto opening = [&](double u) { return dithered_opening(u + u0, A_avg, std::min(delta, 0.99 * Lv), Lv); };
 
@@ -260,7 +283,7 @@ class PneumaticRotaryModel : public RigModel {
     // Slow part of dp at the start: the measured mean over one dither period
     // less the modelled ripple's mean there.
     double rip0 = 0.0;
-    for (std::size_t i = 0; i < dp0_window_; ++i) rip0 += ripple(i, fund_prev) / static_cast<double>(dp0_window_);
+    for (std::size_t i = 0; i < dp0_window_; ++i) rip0 += ripple(i, fund_prev, n_rest) / static_cast<double>(dp0_window_);
     double theta = theta0_, omega = 0.0, dp = dp0_ - rip0, z = 0.0;
     const double h = dt_ / kSubsteps;
     const double S = hs + tc;  // level of the sign-like torques
@@ -272,7 +295,7 @@ class PneumaticRotaryModel : public RigModel {
       h_fund[k] = fund_prev;  // the ripple at t_k comes from the opening over the period before it
       const double s = std::min(static_cast<double>(k), static_cast<double>(k) - shift);
       const double theta_m = at(h_theta, s);
-      const double dp_m = at(h_dp, s) + ripple(k, at(h_fund, s));
+      const double dp_m = at(h_dp, s) + ripple(k, at(h_fund, s), exponent(omega));
       y[0][k] = theta_m;
       y[1][k] = dp_m;
       sample.value[0] = theta_m;
@@ -287,7 +310,8 @@ class PneumaticRotaryModel : public RigModel {
       // mean speed. Second order, so the sub-step leaves no O(h) time shift
       // between angle and pressure that would pass for a sensor delay.
       for (int j = 0; j < kSubsteps; ++j) {
-        dp += 0.5 * h * (gas * flow - leak * dp - 2.0 * mot * omega);
+        const double n = exponent(omega);  // over the sub-step, at its start's speed
+        dp += 0.5 * h * n * (gas0 * flow - gas0 * C2 * dp - 2.0 * mot0 * omega);
         const double th_ = sign_like ? std::tanh(omega / kEps) : 0.0;
         const double T = alpha * dp - te * z + stop_torque(theta + 0.5 * h * omega, omega);
         // Semi-implicit in omega for the stiff tanh and the viscous term.
@@ -300,7 +324,7 @@ class PneumaticRotaryModel : public RigModel {
           const double e = std::exp(-a);
           z = z * e + (wm * h / thr) * (a > 1e-12 ? (1.0 - e) / a : 1.0 - 0.5 * a);
         }
-        dp += 0.5 * h * (gas * flow - leak * dp - 2.0 * mot * wn);
+        dp += 0.5 * h * n * (gas0 * flow - gas0 * C2 * dp - 2.0 * mot0 * wn);
         omega = wn;
       }
       if (torque) {
