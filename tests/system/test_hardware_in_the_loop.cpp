@@ -96,14 +96,38 @@ constexpr double kRampEnd = 1.0 + 0.08 / 0.02;
 // on both cores: tracking rms 0.07-0.09 mm, max 0.5-0.8 mm; x_r and x_w
 // from the ramp's end rms 0.05-0.11 mm, max 0.3-0.9 mm; x_b rms 0.31-0.40
 // mm, max 2.4-2.6 mm.
-void expect_matches_in_process_run(const std::string& hardware_csv, const std::string& reference_csv) {
+//
+// A loop that woke late or missed ticks held the valve's command meanwhile
+// while rig-sim's plant went on in real time: the two runs then differ by
+// the rod's travel over that time, which is the machine's load and not the
+// hardware path. So the peak bounds grow by the peak rod speed times the
+// longest time the loop was away, as `rigctl run` measured and printed it
+// (the largest wake-up latency plus every missed tick's period; an upper
+// bound, the two can overlap). With stress-ng on both cores and another
+// agent's builds beside it, one soak run's CANopen path peaked at 6.2 mm
+// (0.19 m/s for 33 ms) with its rms still 0.47 mm.
+double peak_allowance(const std::string& run_output) {
+  constexpr double kPeakRodSpeed = 0.19;  // [m/s] the step test's, as above
+  std::smatch m;
+  double away_s = 0.0;
+  if (std::regex_search(run_output, m, std::regex(R"(wake-up latency: .*max ([0-9.]+) us)"))) away_s += std::stod(m[1]) * 1e-6;
+  if (std::regex_search(run_output, m, std::regex(R"(missed ticks ([0-9]+))"))) away_s += std::stod(m[1]) * kPeriod;
+  const double allowance = kPeakRodSpeed * away_s;
+  std::printf("the loop was away for up to %.1f ms: peak bounds widened by %.3f mm\n", away_s * 1e3, allowance * 1e3);
+  return allowance;
+}
+
+void expect_matches_in_process_run(const std::string& hardware_csv, const std::string& reference_csv,
+                                   const std::string& run_output) {
   const RunFile hw = read_run_file(hardware_csv), ref = read_run_file(reference_csv);
   ASSERT_GT(hw.rows.size(), 8000u);
-  const auto check = [](const std::string& what, std::pair<double, double> d, double max_rms, double max_max) {
+  EXPECT_NE(run_output.find("wake-up latency: "), std::string::npos) << run_output;
+  const double allowance = peak_allowance(run_output);
+  const auto check = [&](const std::string& what, std::pair<double, double> d, double max_rms, double max_max) {
     const auto [max, rms] = d;
     std::printf("%s: hardware path vs in-process: max %.3f mm, rms %.3f mm\n", what.c_str(), max * 1e3, rms * 1e3);
     EXPECT_LT(rms, max_rms) << what;
-    EXPECT_LT(max, max_max) << what;
+    EXPECT_LT(max, max_max + allowance) << what;
   };
   check("x_r - x_ref (whole run)",
         difference(hw.column("t"), minus(hw.column("x_r"), hw.column("x_ref")), ref.column("t"),
@@ -132,7 +156,7 @@ TEST_F(HardwareInTheLoop, StepTestOverModbusTcpMatchesTheInProcessSimulation) {
   ASSERT_EQ(run_command(kRigctl + " run " + kConfig + " --fast --log " + path("ref.lcm") + " --csv " + path("ref.csv"))
                 .exit_code,
             0);
-  expect_matches_in_process_run(path("hw.csv"), path("ref.csv"));
+  expect_matches_in_process_run(path("hw.csv"), path("ref.csv"), run.output);
 }
 
 TEST_F(HardwareInTheLoop, StepTestWithTheCanopenValveMatchesTheInProcessSimulation) {
@@ -146,7 +170,7 @@ TEST_F(HardwareInTheLoop, StepTestWithTheCanopenValveMatchesTheInProcessSimulati
   ASSERT_EQ(run_command(kRigctl + " run " + kConfig + " --fast --log " + path("ref.lcm") + " --csv " + path("ref.csv"))
                 .exit_code,
             0);
-  expect_matches_in_process_run(path("hw.csv"), path("ref.csv"));
+  expect_matches_in_process_run(path("hw.csv"), path("ref.csv"), run.output);
   // The valve's own spool actual value comes back as an input.
   EXPECT_FALSE(read_run_file(path("hw.csv")).column("x_s").empty());
 }
