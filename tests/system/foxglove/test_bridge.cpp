@@ -9,6 +9,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <filesystem>
@@ -66,11 +67,24 @@ TEST_F(Bridge, ServesALogReplayedOnTheRigNetwork) {
   const auto play = run_command(ns.exec_prefix() + "lcm-logplayer --lcm-url='" + kUrl + "' " + path("run.lcm"));
   ASSERT_EQ(play.exit_code, 0) << play.output;
   ASSERT_EQ(client.wait(), 0) << client.output();
+  // The operator console's page on the same port (watch-only here: the
+  // bridge offers no command channel), fetched over plain HTTP as a
+  // browser would, with bash's /dev/tcp inside the namespace.
+  const auto page = run_command(ns.exec_prefix() +
+                                "bash -c 'exec 3<>/dev/tcp/127.0.0.1/8765 && printf \"GET / HTTP/1.1\\r\\nHost: "
+                                "127.0.0.1\\r\\nConnection: close\\r\\n\\r\\n\" >&3 && cat <&3'");
+  EXPECT_EQ(page.exit_code, 0) << page.output;
+  EXPECT_EQ(page.output.rfind("HTTP/1.1 200", 0), 0U) << page.output.substr(0, 400);
+  EXPECT_NE(page.output.find("Content-Security-Policy"), std::string::npos) << page.output.substr(0, 400);
+  EXPECT_NE(page.output.find("<title>rigctl console</title>"), std::string::npos) << page.output.substr(0, 400);
   EXPECT_EQ(bridge.stop(), 0) << bridge.output();
   EXPECT_NE(bridge.output().find("(foxglove.sdk.v1)"), std::string::npos) << bridge.output();
 
   const auto r = read_json(path("client.json"));
   EXPECT_EQ(r["subprotocol"], "foxglove.sdk.v1");
+  // Watch-only: the page's commands have no channel to go to.
+  const auto& capabilities = r["serverInfo"]["capabilities"];
+  EXPECT_EQ(std::find(capabilities.begin(), capabilities.end(), "clientPublish"), capabilities.end()) << capabilities;
   EXPECT_EQ(r["received"], 400);
   EXPECT_EQ(r["outOfOrder"], 0);
   // UDP multicast on loopback: at 400 Hz nothing is lost on these machines;
