@@ -99,14 +99,11 @@ std::unique_ptr<foxglove::TelemetryServer> make_foxglove_server(const RigConfig&
   return std::make_unique<foxglove::TelemetryServer>(so, config.telemetry.channel_prefix, rig_parameters(config));
 }
 
-}  // namespace
 
-RunReport run_rig(const RunOptions& options, const std::atomic<bool>& stop, std::ostream& out) {
-  return run_rig(load_rig_config(options.config_path, options.case_name), options, stop, out);
-}
-
-RunReport run_rig(const RigConfig& config, const RunOptions& options, const std::atomic<bool>& stop, std::ostream& out) {
-  AssembledRig rig = assemble_rig(config);
+// The run's own parts over the config's (the commissioning commands'
+// demand and controller), the --fast check and the injected faults.
+// Returns the simulated driver, or nullptr on hardware.
+SimDriver* apply_run_options(AssembledRig& rig, const RigConfig& config, const RunOptions& options) {
   if (options.profile_override) {
     auto raw = options.profile_override();
     rig.profile_duration_s = raw->duration();
@@ -126,28 +123,35 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
     }
     sim->set_faults(faults);
   }
+  return sim;
+}
 
-  OperatorModeOptions op;
-  op.force = options.operator_mode;
-  op.key_path = options.key_path;
-  const bool operator_run = operator_mode(config, op);
-  if (operator_run) rig.safety.auto_sequence = false;  // --operator overrides the file
-  // Operator mode runs until the operator ends it (stop, then hydraulics off)
-  // or a signal, unless --duration bounds it.
-  const bool unbounded = operator_run && !options.duration_s;
-  const double duration = options.duration_s.value_or(unbounded ? 0.0 : rig.profile_duration_s);
-  if (!unbounded && !(duration > 0.0)) throw std::runtime_error("run duration must be positive");
-  LoopOptions loop_options;
-  loop_options.period_ns = std::llround(config.loop.period_s * 1e9);
-  loop_options.overrun_policy = config.loop.overrun_policy;
-  loop_options.max_ticks = unbounded ? std::numeric_limits<int64_t>::max() : std::llround(duration / config.loop.period_s);
-  loop_options.start_from_input = rig.profile_start_input;
-  loop_options.timing_every_ticks = std::max<int64_t>(1, std::llround(config.loop.timing_publish_s / config.loop.period_s));
+struct RunLength {
+  bool unbounded = false;  // operator mode without --duration: until the operator ends it
+  double duration_s = 0.0;
+};
 
-  RunReport report;
-  report.log_path = options.log_path.empty() ? default_log_path(config.telemetry.log_dir, std::string(to_string(config.rig))) : options.log_path;
-  report.csv_path = options.csv_path;
+// Operator mode runs until the operator ends it (stop, then hydraulics off)
+// or a signal, unless --duration bounds it.
+RunLength run_length(const AssembledRig& rig, const RunOptions& options, bool operator_run) {
+  RunLength l;
+  l.unbounded = operator_run && !options.duration_s;
+  l.duration_s = options.duration_s.value_or(l.unbounded ? 0.0 : rig.profile_duration_s);
+  if (!l.unbounded && !(l.duration_s > 0.0)) throw std::runtime_error("run duration must be positive");
+  return l;
+}
 
+LoopOptions loop_options_for(const RigConfig& config, const AssembledRig& rig, const RunLength& length) {
+  LoopOptions o;
+  o.period_ns = std::llround(config.loop.period_s * 1e9);
+  o.overrun_policy = config.loop.overrun_policy;
+  o.max_ticks = length.unbounded ? std::numeric_limits<int64_t>::max() : std::llround(length.duration_s / config.loop.period_s);
+  o.start_from_input = rig.profile_start_input;
+  o.timing_every_ticks = std::max<int64_t>(1, std::llround(config.loop.timing_publish_s / config.loop.period_s));
+  return o;
+}
+
+TelemetryMeta telemetry_meta_for(const RigConfig& config, const AssembledRig& rig, const LoopOptions& loop, bool fast) {
   TelemetryMeta meta;
   meta.rig = to_string(config.rig);
   meta.layout = rig.driver->layout();
@@ -156,11 +160,106 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
   meta.term_names = rig.controller->term_names();
   meta.channel_prefix = config.telemetry.channel_prefix;
   meta.overrun_policy = std::string(to_string(config.loop.overrun_policy));
-  meta.period_ns = loop_options.period_ns;
+  meta.period_ns = loop.period_ns;
   meta.start_utime = wall_utime_now();
   // Simulated time has no deadline to keep: a full queue holds the loop back
   // instead of losing records (rt/queue_full_policy.hpp).
-  meta.queue_policy = options.fast ? QueueFullPolicy::kWait : QueueFullPolicy::kDrop;
+  meta.queue_policy = fast ? QueueFullPolicy::kWait : QueueFullPolicy::kDrop;
+  return meta;
+}
+
+void print_run_header(const RigConfig& config, const RunOptions& options, const RunLength& length,
+                      const TelemetryMeta& meta, const std::string& url, const foxglove::TelemetryServer* server,
+                      const CommandReceiver* receiver, std::ostream& out) {
+  out << "rigctl run: " << config.rig << " (" << config.driver << " driver) from " << options.config_path
+      << (options.case_name.empty() ? "" : " case " + options.case_name) << ", "
+      << (length.unbounded ? std::string("until stopped") : fmt::format("{:g} s", length.duration_s)) << " "
+      << (options.fast ? "as fast as possible" : "paced by the real clock") << "\n"
+      << "  telemetry: " << url << " channels " << config.telemetry.channel_prefix << "*, a full queue "
+      << (meta.queue_policy == QueueFullPolicy::kWait ? "holds the loop back (simulated time: nothing is dropped)"
+                                                       : "drops and counts (the tick never waits)")
+      << "\n";
+  if (server) {
+    out << "  foxglove: " << server->url() << " serves " << config.telemetry.channel_prefix
+        << "* as JSON (Foxglove, Lichtblick; docs/foxglove.md)\n";
+  }
+  if (receiver) {
+    out << "  operator mode: the rig powers up faulted; commands on " << receiver->channel() << " (acks on "
+        << receiver->ack_channel() << ")\n";
+  }
+  out.flush();
+}
+
+// How the run ended and how the loop kept its period.
+void print_run_summary(const RigConfig& config, const RunOptions& options, const RunReport& report,
+                       const Driver& driver, std::ostream& out) {
+  const LoopResult& result = report.loop;
+  const auto& t = result.timing;
+  out << "  ended: " << to_string(result.final_state) << " (" << report.end_reason << ") after " << result.ticks << " ticks ("
+      << std::fixed << std::setprecision(3) << static_cast<double>(result.ticks) * config.loop.period_s
+      << " s rig time, " << report.wall_s << " s wall), rig state " << to_string(result.final_safety_state) << "\n";
+  if (!options.fast) {
+    out << "  wake-up latency: " << describe(t.wakeup_latency) << "\n"
+        << "  compute per tick: " << describe(t.compute) << "\n"
+        << "    longest per step: " << describe_stages(t.stages.max_ns) << "\n"
+        << "    slowest tick (" << t.stages.slowest_tick << "): " << describe_stages(t.stages.slowest_tick_ns) << "\n"
+        << (driver.io_latency().count > 0 ? "  I/O round trip: " + describe(driver.io_latency()) + "\n" : "")
+        << "  overruns: " << t.overruns << " (missed ticks " << t.missed_ticks << ", policy "
+        << to_string(config.loop.overrun_policy) << ")\n";
+  }
+  if (result.dropped_records > 0) out << "  telemetry records dropped: " << result.dropped_records << "\n";
+}
+
+
+// The operator's command receiver of an operator-mode run, on the run's LCM
+// URL, with the unit of the setpoint commands (the loop's feedback input).
+std::unique_ptr<CommandReceiver> open_command_receiver(const RigConfig& config, const AssembledRig& rig,
+                                                       const std::string& url, OperatorModeOptions op, EventLog& events) {
+  op.lcm_url = url;
+  const auto feedback = static_cast<std::size_t>(std::max(0, rig.safety.feedback_input));
+  const auto& inputs = rig.driver->layout().inputs;
+  op.setpoint_unit = feedback < inputs.size() ? inputs[feedback].unit : "";
+  return make_operator_receiver(config, op, events);
+}
+
+// Where the run's records went, and anything that did not get there.
+void print_run_records(const RunReport& report, const TelemetryPublisher& publisher, const EventLog& events,
+                       const CommandReceiver* receiver, const foxglove::TelemetryServer* server, std::ostream& out) {
+  if (publisher.queue_waits() > 0) {
+    out << "  telemetry queue full " << publisher.queue_waits() << " times: the loop waited for the publisher\n";
+  }
+  out << "  log: " << report.log_path << "\n";
+  const EventLogStats es = events.stats();
+  out << "  events: " << report.events_path << " (" << es.written << " lines, " << std::setprecision(2)
+      << "longest write+fsync " << es.max_fsync_ms << " ms" << (es.pending > 0 ? ", " + std::to_string(es.pending) + " NOT WRITTEN" : "")
+      << ")\n";
+  if (receiver) out << "  operator commands: " << describe_counters(receiver->counters()) << "\n";
+  if (server) out << "  foxglove: " << server->describe_clients() << "\n";
+  if (publisher.log_failures() > 0) out << "  run log write failures: " << publisher.log_failures() << "\n";
+}
+
+}  // namespace
+
+RunReport run_rig(const RunOptions& options, const std::atomic<bool>& stop, std::ostream& out) {
+  return run_rig(load_rig_config(options.config_path, options.case_name), options, stop, out);
+}
+
+RunReport run_rig(const RigConfig& config, const RunOptions& options, const std::atomic<bool>& stop, std::ostream& out) {
+  AssembledRig rig = assemble_rig(config);
+  SimDriver* sim = apply_run_options(rig, config, options);
+
+  OperatorModeOptions op;
+  op.force = options.operator_mode;
+  op.key_path = options.key_path;
+  const bool operator_run = operator_mode(config, op);
+  if (operator_run) rig.safety.auto_sequence = false;  // --operator overrides the file
+  const RunLength length = run_length(rig, options, operator_run);
+  const LoopOptions loop_options = loop_options_for(config, rig, length);
+
+  RunReport report;
+  report.log_path = options.log_path.empty() ? default_log_path(config.telemetry.log_dir, std::string(to_string(config.rig))) : options.log_path;
+  report.csv_path = options.csv_path;
+  const TelemetryMeta meta = telemetry_meta_for(config, rig, loop_options, options.fast);
   const std::string url = options.lcm_url.empty() ? config.telemetry.lcm_url : options.lcm_url;
   // Ten seconds of records: a paced run's publisher thread would have to
   // stall that long before the loop drops telemetry.
@@ -188,11 +287,7 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
   std::unique_ptr<CommandReceiver> receiver;
   SpscQueue<OperatorCommand>* commands = options.operator_commands;
   if (operator_run && commands == nullptr) {
-    op.lcm_url = url;
-    const auto feedback = static_cast<std::size_t>(std::max(0, rig.safety.feedback_input));
-    const auto& inputs = rig.driver->layout().inputs;
-    op.setpoint_unit = feedback < inputs.size() ? inputs[feedback].unit : "";
-    receiver = make_operator_receiver(config, op, events);
+    receiver = open_command_receiver(config, rig, url, op, events);
     commands = &receiver->queue();
     if (foxglove_server) foxglove_server->enable_console_commands(*receiver);
   }
@@ -216,24 +311,19 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
   // Threads started before the RealtimeSession keep normal priority.
   if (receiver) receiver->start();
   notifier.start();
+  // The one way down, after the loop or on its failure: the receiver before
+  // the event log (its last rejections go in), the logs kept (what was
+  // recorded stays), the driver last (the valve stays safe until then).
+  auto stop_services = [&](const char* why) {
+    notifier.stop(why);
+    if (receiver) receiver->stop();
+    events.stop();
+    publisher.stop();
+    if (foxglove_server) foxglove_server->stop();
+    rig.driver->stop();
+  };
 
-  out << "rigctl run: " << config.rig << " (" << config.driver << " driver) from " << options.config_path
-      << (options.case_name.empty() ? "" : " case " + options.case_name) << ", "
-      << (unbounded ? std::string("until stopped") : fmt::format("{:g} s", duration)) << " "
-      << (options.fast ? "as fast as possible" : "paced by the real clock") << "\n"
-      << "  telemetry: " << url << " channels " << config.telemetry.channel_prefix << "*, a full queue "
-      << (meta.queue_policy == QueueFullPolicy::kWait ? "holds the loop back (simulated time: nothing is dropped)"
-                                                       : "drops and counts (the tick never waits)")
-      << "\n";
-  if (foxglove_server) {
-    out << "  foxglove: " << foxglove_server->url() << " serves " << config.telemetry.channel_prefix
-        << "* as JSON (Foxglove, Lichtblick; docs/foxglove.md)\n";
-  }
-  if (receiver) {
-    out << "  operator mode: the rig powers up faulted; commands on " << receiver->channel() << " (acks on "
-        << receiver->ack_channel() << ")\n";
-  }
-  out.flush();
+  print_run_header(config, options, length, meta, url, foxglove_server.get(), receiver.get(), out);
 
   MonotonicClock monotonic;
   VirtualClock virtual_clock;
@@ -255,7 +345,7 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
     std::optional<ConsoleStatus> status;
     if (!options.fast) {
       status.emplace(publisher, meta, rig.driver->layout().input_index(config.controller.feedback),
-                   unbounded ? std::numeric_limits<double>::infinity() : duration, out);
+                     length.unbounded ? std::numeric_limits<double>::infinity() : length.duration_s, out);
     }
     RigLoop loop(*rig.driver, *rig.controller, *rig.profile, rig.detectors, heartbeat, clock, loop_options,
                  rig.safety);
@@ -264,51 +354,18 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
     try {
       result = loop.run(stop);
     } catch (...) {
-      notifier.stop("control loop failed");
-      if (receiver) receiver->stop();
-      events.stop();
-      publisher.stop();  // keep what was recorded
-      if (foxglove_server) foxglove_server->stop();
-      rig.driver->stop();
+      stop_services("control loop failed");
       throw;
     }
   }
   report.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  notifier.stop("control loop ended, closing the logs");
-  if (receiver) receiver->stop();  // before the event log closes: its last rejections go in
-  events.stop();
-  publisher.stop();
-  if (foxglove_server) foxglove_server->stop();
-  rig.driver->stop();
+  stop_services("control loop ended, closing the logs");
   result.dropped_records = publisher.dropped();
   report.loop = result;
-
-  const auto& t = result.timing;
   report.end_reason = end_reason(result.end_event, meta.layout, *rig.driver);
-  out << "  ended: " << to_string(result.final_state) << " (" << report.end_reason << ") after " << result.ticks << " ticks ("
-      << std::fixed << std::setprecision(3) << static_cast<double>(result.ticks) * config.loop.period_s
-      << " s rig time, " << report.wall_s << " s wall), rig state " << to_string(result.final_safety_state) << "\n";
-  if (!options.fast) {
-    out << "  wake-up latency: " << describe(t.wakeup_latency) << "\n"
-        << "  compute per tick: " << describe(t.compute) << "\n"
-        << "    longest per step: " << describe_stages(t.stages.max_ns) << "\n"
-        << "    slowest tick (" << t.stages.slowest_tick << "): " << describe_stages(t.stages.slowest_tick_ns) << "\n"
-        << (rig.driver->io_latency().count > 0 ? "  I/O round trip: " + describe(rig.driver->io_latency()) + "\n" : "")
-        << "  overruns: " << t.overruns << " (missed ticks " << t.missed_ticks << ", policy "
-        << to_string(config.loop.overrun_policy) << ")\n";
-  }
-  if (report.loop.dropped_records > 0) out << "  telemetry records dropped: " << report.loop.dropped_records << "\n";
-  if (publisher.queue_waits() > 0) {
-    out << "  telemetry queue full " << publisher.queue_waits() << " times: the loop waited for the publisher\n";
-  }
-  out << "  log: " << report.log_path << "\n";
-  const EventLogStats es = events.stats();
-  out << "  events: " << report.events_path << " (" << es.written << " lines, " << std::setprecision(2)
-      << "longest write+fsync " << es.max_fsync_ms << " ms" << (es.pending > 0 ? ", " + std::to_string(es.pending) + " NOT WRITTEN" : "")
-      << ")\n";
-  if (receiver) out << "  operator commands: " << describe_counters(receiver->counters()) << "\n";
-  if (foxglove_server) out << "  foxglove: " << foxglove_server->describe_clients() << "\n";
-  if (publisher.log_failures() > 0) out << "  run log write failures: " << publisher.log_failures() << "\n";
+
+  print_run_summary(config, options, report, *rig.driver, out);
+  print_run_records(report, publisher, events, receiver.get(), foxglove_server.get(), out);
   if (!report.csv_path.empty()) {
     const auto csv =
         log_to_csv(report.log_path, report.csv_path, config.telemetry.channel_prefix, options.csv_truth_channels);
