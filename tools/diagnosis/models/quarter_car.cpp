@@ -136,12 +136,15 @@ class QuarterCarModel : public RigModel {
     // tolerance: 5 % for masses, stiffnesses, areas, volumes, supply and bulk
     // modulus (catalogue and drawing values); 10 % for damping, the valve's
     // gain and time constant and the leakage (worn parts, data sheets).
+    // Far below its band, the leakage resistance is a worn seal and the bulk
+    // modulus aerated oil: those moves are the causes' (ParamSpec::stands_for).
     const auto& p = p_;
     return {Prior("ks", "N/m", p.spring_stiffness, 0.05),       Prior("bd", "N s/m", p.damper_damping, 0.10),
             Prior("Mb", "kg", p.mass_body, 0.05),                Prior("Mw", "kg", p.mass_wheel, 0.05),
             Prior("kt", "N/m", p.tyre_stiffness, 0.05),          Prior("bt", "N s/m", p.tyre_damping, 0.10),
             Prior("kv_scale", "1", 1.0, 0.10),                   Prior("tau_r", "s", p.valve_time_constant, 0.10),
-            Prior("beta", "Pa", p.bulk_modulus, 0.05),           Prior("R_l", "Pa s/m^3", p.leakage_resistance, 0.10),
+            StandsFor(Prior("beta", "Pa", p.bulk_modulus, 0.05), "entrained_air", -1),
+            StandsFor(Prior("R_l", "Pa s/m^3", p.leakage_resistance, 0.10), "cross_port_leakage", -1),
             Prior("Ps", "Pa", p.supply_pressure, 0.05),          Prior("A1", "m^2", p.area_cap, 0.05),
             Prior("A2", "m^2", p.area_rod, 0.05),                Prior("Bvr", "N s/m", p.rod_damping, 0.10),
             Prior("V_dead", "m^3", p.dead_volume_cap, 0.05)};
