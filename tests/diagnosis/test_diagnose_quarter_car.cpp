@@ -58,6 +58,9 @@ const std::vector<Case>& cases() {
       // A worn seal's turbulent leak (not the candidate's laminar formula),
       // which the calibration took whole into R_l before R_l had a band.
       {"cross_port_leakage_strong", {"cross_port_leakage:strong"}, 1, 0},
+      // An offset on the wheel's transducer (form 1), which the actuator's
+      // replay also takes in through the tyre load.
+      {"sensor_offset_wheel_strong", {"sensor_offset:strong"}, 11, 1},
       // A clean rig drawn with R_l and beta both 4 % low: inside their bands.
       {"clean_low_leakage_resistance", {}, 11},
   };
@@ -161,6 +164,19 @@ TEST(HiddenEffectsQuarterCar, StrongSensorDelayIsNamedAndSized) {
   if (!c) return;
   const double want = truth(outcome("sensor_delay_strong"), "sensor_delay.tau");
   EXPECT_NEAR(fitted(*c, "tau"), want, 0.2 * want);
+}
+
+// The actuator's replay drives the tyre with the measured x_w, so a 2 mm
+// offset on that transducer is also 1840 N of tyre load in the pressures.
+// The offset candidate corrects both sub-models' wheel position: named
+// alone, not with a leak and air that the pressures' misfit once earned.
+TEST(HiddenEffectsQuarterCar, StrongWheelSensorOffsetIsNamedAloneAndSized) {
+  const auto* c = expect_named("sensor_offset_wheel_strong", "sensor_offset");
+  if (!c) return;
+  const Outcome& o = outcome("sensor_offset_wheel_strong");
+  EXPECT_EQ(o.diagnosis.causes.size(), 1u) << summary(o);
+  const double want = truth(o, "sensor_offset.b_w");
+  EXPECT_NEAR(fitted(*c, "b_w"), want, 0.1 * std::abs(want));
 }
 
 // A leak is the baseline's leakage resistance far below nominal: the
