@@ -91,6 +91,27 @@ class LagModel : public RigModel {
   std::vector<Output> outputs_;
 };
 
+// The same lag whose gain stands for a cause: a worn part loses gain
+// (docs/diagnosis.md 4, parameters that stand for a cause). The baseline's
+// gain calibrates only within two tolerances below nominal (-10 %); the
+// candidate `gain_loss` carries a loss beyond that.
+class WornLagModel : public LagModel {
+ public:
+  explicit WornLagModel(const Truth& truth) : LagModel(truth), u_(input()) {}
+  std::vector<ParamSpec> baseline() const override {
+    return {StandsFor(Prior("gain", "1", kGain, 0.05), "gain_loss", -1), Prior("tau", "s", kTau, 0.05)};
+  }
+  std::vector<EffectSpec> effects() const override {
+    return {{"gain_loss", {P("loss", "1", 0.05, 0.0, 0.9, 0.05, 0.0, true)}, "the gain falls by a fraction loss"}};
+  }
+  void simulate(const std::vector<double>& th, std::vector<std::vector<double>>& y) const override {
+    y = {simulate_lag(u_, th[0] * (1.0 - th[2]), th[1], 0.0, 0.0)};
+  }
+
+ private:
+  std::vector<double> u_;
+};
+
 Diagnosis run(const Truth& truth) {
   LagModel m(truth);
   return diagnose(m, {});
@@ -145,6 +166,35 @@ TEST(DiagnoseVerdicts, AMisfitNoCandidateExplainsIsUnexplainedWithItsBand) {
   EXPECT_NE(j.find("\"unexplained\": true"), std::string::npos);
   EXPECT_NE(j.find("\"band_hz\""), std::string::npos);
   EXPECT_NE(j.find("\"cause\": \"none\""), std::string::npos);
+}
+
+TEST(DiagnoseVerdicts, AParameterFarBeyondItsBandIsItsCauseNotCalibration) {
+  Truth t;
+  t.gain = kGain * 0.7;  // six tolerances low: a worn part, not the rig's spread
+  WornLagModel m(t);
+  const auto d = diagnose(m, {});
+  ASSERT_EQ(d.calibration.size(), 2u);
+  EXPECT_EQ(d.calibration[0].stands_for, "gain_loss");
+  EXPECT_TRUE(d.calibration[0].at_band_edge);
+  EXPECT_NEAR(d.calibration[0].value, kGain * 0.9, kGain * 1e-3) << "held at the band's edge, -10 %";
+  ASSERT_EQ(d.cause, "gain_loss");
+  // With the candidate in, the prior pulls the gain back to nominal and the
+  // loss carries the whole departure.
+  EXPECT_NEAR(d.causes.front().parameters[0].value, 0.3, 0.02);
+  EXPECT_NE(d.causes.front().evidence.find("edge of its band"), std::string::npos) << d.causes.front().evidence;
+  const auto j = json_of(d);
+  EXPECT_NE(j.find("\"stands_for\": \"gain_loss\", \"at_band_edge\": true"), std::string::npos) << j;
+}
+
+TEST(DiagnoseVerdicts, AParameterWithinItsBandIsCalibratedNotAccused) {
+  Truth t;
+  t.gain = kGain * 0.95;  // one tolerance low: the rig's spread
+  WornLagModel m(t);
+  const auto d = diagnose(m, {});
+  EXPECT_EQ(d.cause, "none");
+  ASSERT_EQ(d.calibration.size(), 2u);
+  EXPECT_FALSE(d.calibration[0].at_band_edge);
+  EXPECT_NEAR(d.calibration[0].value, kGain * 0.95, kGain * 0.01);
 }
 
 TEST(DiagnoseVerdicts, AParameterTheRunCannotDetermineIsNullNotItsStart) {

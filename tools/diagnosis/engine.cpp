@@ -55,6 +55,12 @@ Scored calibrate_baseline(Workspace& w, Diagnosis& d) {
     const auto& sp = w.specs[i];
     Calibrated c{sp.name, sp.unit, sp.init, base.theta[i], base.sigma[i], sp.prior, !base.undetermined[i], false};
     c.moved = sp.prior > 0.0 && std::abs(c.value - c.nominal) >= 0.5 * sp.prior * std::abs(c.nominal);
+    if (!sp.stands_for.empty()) {
+      // Within a twentieth of a tolerance of the edge the workspace set.
+      const double edge = sp.toward < 0 ? sp.lo : sp.hi;
+      c.stands_for = sp.stands_for;
+      c.at_band_edge = std::abs(c.value - edge) <= 0.05 * sp.prior * std::abs(c.nominal);
+    }
     d.calibration.push_back(c);
     d.baseline_parameters.push_back({sp.name, sp.unit, c.value, c.sigma, c.determined});
   }
@@ -277,6 +283,11 @@ CauseResult describe(const Workspace& w, const Candidate& win, const std::vector
        << " before, " << fmt(r2b, 2) << " after";
     d.cause_plots.push_back({cr.cause, ind.name, cr.signal, ind.values, before, w.model.effect_term(cr.cause, win.s.theta)});
   }
+  for (const auto& c : d.calibration)
+    if (c.at_band_edge && c.stands_for == cr.cause)
+      ev << "; the calibration held the baseline's " << c.name << " at the edge of its band ("
+         << fmt(100.0 * (c.value - c.nominal) / c.nominal, 3) << " %, " << fmt(kCauseBandTolerances, 2)
+         << " tolerances): the run asked for more, which is this cause";
   if (!cr.signature.empty()) ev << "; signature: " << cr.signature;
   if (!cr.ambiguous_with.empty()) {
     ev << "; about as well explained by";

@@ -32,6 +32,11 @@ struct Calibrated {
   double tolerance = 0.0;  // the prior's relative standard deviation (0: no prior)
   bool determined = true;
   bool moved = false;      // by at least half its tolerance
+  // A parameter that stands for a cause beyond its band (ParamSpec::stands_for):
+  // the cause, and whether the calibration ended at the band's edge (the run
+  // asked for more: evidence for that cause, which its candidate must earn).
+  std::string stands_for;
+  bool at_band_edge = false;
 };
 
 struct CauseResult {

@@ -32,7 +32,23 @@ struct ParamSpec {
   // fit is regularised toward the nominal by it, so a parameter the run does
   // not excite stays put and is reported as undetermined. 0: no prior.
   double prior = 0.0;
+  // A baseline parameter whose departure far beyond its tolerance is itself a
+  // cause of the list: the leakage resistance of a worn seal, the bulk
+  // modulus of aerated oil. `stands_for` is that cause, `toward` the side
+  // (-1: below nominal, +1: above). The calibration keeps such a parameter
+  // within kCauseBandTolerances of its tolerance on that side (the rule is
+  // in workspace.cpp, docs/diagnosis.md 4), so what lies beyond is the
+  // cause's candidate to earn through the gates. Empty: an ordinary one.
+  std::string stands_for;
+  int toward = 0;
 };
+
+// How far (in tolerances) a parameter that stands for a cause may calibrate
+// toward it. Two: a rig's drawn or real spread is about one tolerance (the
+// generator draws within +-5 %, half of R_l's 10 % and one of beta's 5 %),
+// while the weakest leak and air of the generator need several (R_l -40 %
+// and more, beta -25 % and more, docs/diagnosis.md 4).
+constexpr double kCauseBandTolerances = 2.0;
 
 struct EffectSpec {
   std::string cause;  // contract cause id

@@ -107,8 +107,11 @@ void write_json(const Diagnosis& d, std::ostream& out) {
         << ", \"sigma\": " << (c.determined ? json_number(c.sigma) : std::string("null"))
         << ", \"tolerance\": " << json_number(c.tolerance) << ", \"change_percent\": "
         << (c.determined && c.nominal != 0.0 ? json_number(100.0 * (c.value - c.nominal) / c.nominal) : std::string("null"))
-        << ", \"moved\": " << (c.moved ? "true" : "false") << ", \"determined\": " << (c.determined ? "true" : "false")
-        << "}";
+        << ", \"moved\": " << (c.moved ? "true" : "false") << ", \"determined\": " << (c.determined ? "true" : "false");
+    if (!c.stands_for.empty())
+      out << ", \"stands_for\": " << json_string(c.stands_for)
+          << ", \"at_band_edge\": " << (c.at_band_edge ? "true" : "false");
+    out << "}";
   }
   out << (d.calibration.empty() ? "],\n" : "\n  ],\n");
   out << "  \"baseline_parameters\": " << json_values(d.baseline_parameters);

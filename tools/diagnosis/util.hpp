@@ -71,4 +71,12 @@ inline ParamSpec Prior(const std::string& name, const std::string& unit, double 
   return p;
 }
 
+// The same parameter read as `cause` when it departs beyond its tolerance
+// band on the side `toward` (-1 below nominal, +1 above; ParamSpec::stands_for).
+inline ParamSpec StandsFor(ParamSpec p, const std::string& cause, int toward) {
+  p.stands_for = cause;
+  p.toward = toward;
+  return p;
+}
+
 }  // namespace rigctl::diag

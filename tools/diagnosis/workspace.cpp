@@ -10,10 +10,25 @@
 
 namespace rigctl::diag {
 
+namespace {
+
+// A parameter that stands for a cause calibrates only within its band on
+// the cause's side: a move beyond it is not the rig's spread but the cause,
+// which its candidate must earn against this baseline (docs/diagnosis.md 4).
+void hold_within_cause_band(ParamSpec& sp) {
+  if (sp.stands_for.empty() || sp.prior <= 0.0) return;
+  const double edge = sp.init * (1.0 + sp.toward * kCauseBandTolerances * sp.prior);
+  if (sp.toward < 0) sp.lo = std::max(sp.lo, edge);
+  if (sp.toward > 0) sp.hi = std::min(sp.hi, edge);
+}
+
+}  // namespace
+
 Workspace::Workspace(const RigModel& m, const DiagnoseOptions& o)
     : model(m), options(o), effects(m.effects()), t0_(std::chrono::steady_clock::now()) {
   specs = model.baseline();
   n_base = specs.size();
+  for (auto& sp : specs) hold_within_cause_band(sp);
   for (const auto& e : effects) {
     offset.push_back(specs.size());
     for (const auto& p : e.params) specs.push_back(p);

@@ -10,7 +10,9 @@
 //    Outputs x_b, x_w. Causes: bearing_friction, damper_asymmetry,
 //    sensor_delay, sensor_offset, tyre_liftoff.
 // An effect of one sub-model leaves the other's outputs unchanged, so the
-// engine's per-signal gain points at the right place.
+// engine's per-signal gain points at the right place; the two exceptions are
+// tyre lift-off (the tyre is in both) and an offset on the x_w transducer
+// (the actuator's tyre load is driven by the measured x_w).
 #include <algorithm>
 #include <cmath>
 #include <mutex>
@@ -59,7 +61,7 @@ enum : std::size_t {
 
 constexpr std::size_t kSuspensionParams[] = {kKs, kBd, kMb, kMw, kKt, kBt, kFc, kDFs, kD, kMu, kDc, kTau, kBb, kBw, kUni};
 constexpr std::size_t kActuatorParams[] = {kMb,  kMw,  kKt,  kBt,    kKv,    kTauR, kBetaNom, kRl, kPs,  kA1,
-                                           kA2,  kBvr, kVd,  kUni,   kSealPr, kSealPc, kLeak, kDead, kBeta};
+                                           kA2,  kBvr, kVd,  kUni,   kSealPr, kSealPc, kLeak, kDead, kBeta, kBw};
 
 template <std::size_t N>
 std::vector<double> key(const std::vector<double>& th, const std::size_t (&idx)[N]) {
@@ -136,12 +138,15 @@ class QuarterCarModel : public RigModel {
     // tolerance: 5 % for masses, stiffnesses, areas, volumes, supply and bulk
     // modulus (catalogue and drawing values); 10 % for damping, the valve's
     // gain and time constant and the leakage (worn parts, data sheets).
+    // Far below its band, the leakage resistance is a worn seal and the bulk
+    // modulus aerated oil: those moves are the causes' (ParamSpec::stands_for).
     const auto& p = p_;
     return {Prior("ks", "N/m", p.spring_stiffness, 0.05),       Prior("bd", "N s/m", p.damper_damping, 0.10),
             Prior("Mb", "kg", p.mass_body, 0.05),                Prior("Mw", "kg", p.mass_wheel, 0.05),
             Prior("kt", "N/m", p.tyre_stiffness, 0.05),          Prior("bt", "N s/m", p.tyre_damping, 0.10),
             Prior("kv_scale", "1", 1.0, 0.10),                   Prior("tau_r", "s", p.valve_time_constant, 0.10),
-            Prior("beta", "Pa", p.bulk_modulus, 0.05),           Prior("R_l", "Pa s/m^3", p.leakage_resistance, 0.10),
+            StandsFor(Prior("beta", "Pa", p.bulk_modulus, 0.05), "entrained_air", -1),
+            StandsFor(Prior("R_l", "Pa s/m^3", p.leakage_resistance, 0.10), "cross_port_leakage", -1),
             Prior("Ps", "Pa", p.supply_pressure, 0.05),          Prior("A1", "m^2", p.area_cap, 0.05),
             Prior("A2", "m^2", p.area_rod, 0.05),                Prior("Bvr", "N s/m", p.rod_damping, 0.10),
             Prior("V_dead", "m^3", p.dead_volume_cap, 0.05)};
@@ -175,14 +180,16 @@ class QuarterCarModel : public RigModel {
     };
   }
   // Suspension causes move only the suspension's parameters (the tyre and
-  // masses are in both); actuator causes only the actuator's; lift-off both.
+  // masses are in both); actuator causes only the actuator's; lift-off and
+  // the sensor offset both (an offset on x_w is also in the actuator's
+  // wheel input, so the actuator's calibration may have bent to it).
   bool couples(std::size_t index, const std::string& cause) const override {
-    static const char* kSuspensionCauses[] = {"bearing_friction", "damper_asymmetry", "sensor_delay", "sensor_offset"};
+    static const char* kSuspensionCauses[] = {"bearing_friction", "damper_asymmetry", "sensor_delay"};
     const bool suspension_param = index <= kBt;
     const bool shared = index >= kMb && index <= kBt;
     for (const char* c : kSuspensionCauses)
       if (cause == c) return suspension_param;
-    if (cause == "tyre_liftoff") return true;
+    if (cause == "tyre_liftoff" || cause == "sensor_offset") return true;
     return !suspension_param || shared;
   }
   std::string replay() const override {
@@ -363,7 +370,10 @@ class QuarterCarModel : public RigModel {
         y[4][i] = a.p1;
         y[5][i] = a.p2;
       }
-      const double xw0 = xw_[i], xw1 = i + 1 < n ? xw_[i + 1] : xw_[i];
+      // The tyre load is driven by the wheel's true position: the measured
+      // x_w less the candidate's transducer offset b_w (1840 N per 2 mm of
+      // offset at kt, which the pressures show).
+      const double xw0 = xw_[i] - th[kBw], xw1 = (i + 1 < n ? xw_[i + 1] : xw_[i]) - th[kBw];
       const double vw = (xw1 - xw0) / dt_;
       for (int k = 0; k < sub; ++k) {
         const double xw = xw0 + (xw1 - xw0) * (k + 0.5) / sub;
