@@ -22,15 +22,22 @@ struct ValveActual {
 class LatestValveActual {
  public:
   void store(const ValveActual& a) noexcept {
-    const uint32_t s = seq_.load(std::memory_order_relaxed);
-    seq_.store(s + 1, std::memory_order_relaxed);  // odd: write in progress
+    begin_store();
+    finish_store(a);
+  }
+  // The two halves of store(). Between them readers get no copy: what a
+  // writer preempted inside a store looks like to them (tests hold it open).
+  void begin_store() noexcept {
+    seq_.store(seq_.load(std::memory_order_relaxed) | 1U, std::memory_order_relaxed);  // odd: write in progress
     std::atomic_thread_fence(std::memory_order_release);
+  }
+  void finish_store(const ValveActual& a) noexcept {
     rx_ns_.store(a.rx_ns, std::memory_order_relaxed);
     count_.store(a.count, std::memory_order_relaxed);
     status_word_.store(a.status_word, std::memory_order_relaxed);
     spool_.store(a.spool, std::memory_order_relaxed);
     pressure_.store(a.pressure, std::memory_order_relaxed);
-    seq_.store(s + 2, std::memory_order_release);
+    seq_.store(seq_.load(std::memory_order_relaxed) + 1, std::memory_order_release);  // even: done
   }
 
   // False when no consistent copy could be had in a few tries (the writer
@@ -58,6 +65,16 @@ class LatestValveActual {
   std::atomic<double> spool_{0.0};
   std::atomic<double> pressure_{0.0};
 };
+
+// One reader's view: the latest consistent copy, or, while the writer is
+// inside a store, the copy this reader had before (`kept`, the reader's
+// own). Its receive time then ages, so a writer that never finishes shows
+// as a stale value, not as a missing one.
+inline ValveActual load_or_keep(const LatestValveActual& latest, ValveActual& kept) noexcept {
+  ValveActual a;
+  if (latest.load(a)) kept = a;
+  return kept;
+}
 
 static_assert(std::atomic<double>::is_always_lock_free);
 static_assert(std::atomic<int64_t>::is_always_lock_free);

@@ -282,8 +282,8 @@ bool CanopenValve::healthy(int64_t now_ns) const noexcept {
 void CanopenValve::read_actual(Sample& out, std::size_t first_index, int64_t now_ns) const noexcept {
   const std::size_t n = input_count();
   if (first_index + n > kMaxInputs) return;
-  ValveActual a;
-  const bool have = latest_.load(a) && a.count > 0;  // one consistent copy for values and checks
+  const ValveActual a = load_or_keep(latest_, loop_copy_);  // one consistent copy for values and checks
+  const bool have = a.count > 0;
   out.value[first_index] = have ? a.spool : 0.0;
   if (n == 2) out.value[first_index + 1] = have ? a.pressure : 0.0;
   bool usable = false;

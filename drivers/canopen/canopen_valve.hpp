@@ -165,7 +165,9 @@ class CanopenValve {
   // index; sets their out.status bits when the values must not be used (see
   // the header comment). Does nothing if the inputs would not fit.
   void read_actual(Sample& out, std::size_t first_index, int64_t now_ns) const noexcept;
-  // True when read_actual() at now_ns would report valid inputs.
+  // True when read_actual() at now_ns would report valid inputs (for other
+  // threads, tests: it keeps no copy of its own, so while the I/O thread is
+  // inside a store it says false where the loop would go on with its copy).
   bool healthy(int64_t now_ns) const noexcept;
   static int64_t clock_ns() noexcept;
 
@@ -279,6 +281,11 @@ class CanopenValve {
 
   // Shared with the real-time loop and diagnostics().
   LatestValveActual latest_;
+  // The loop's own last consistent copy (read_actual() only, the loop's
+  // thread): when the I/O thread is preempted inside a store, the sequence
+  // lock gives no copy for a moment, and the loop goes on with this one,
+  // judged by its age like any other (stale after actual_max_age_s).
+  mutable ValveActual loop_copy_{};
   std::atomic<int64_t> last_heartbeat_ns_{0};
   std::atomic<uint8_t> valve_state_{0};
   std::atomic<uint32_t> faults_{kFaultNotRunning};
