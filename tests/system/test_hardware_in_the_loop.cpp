@@ -105,7 +105,8 @@ constexpr double kRampEnd = 1.0 + 0.08 / 0.02;
 // (the largest wake-up latency plus every missed tick's period; an upper
 // bound, the two can overlap). With stress-ng on both cores and another
 // agent's builds beside it, one soak run's CANopen path peaked at 6.2 mm
-// (0.19 m/s for 33 ms) with its rms still 0.47 mm.
+// with its rms still 0.47 mm (its latencies were not printed by the test
+// then; 6.2 mm is what 0.19 m/s gives in 33 ms).
 double peak_allowance(const std::string& run_output) {
   constexpr double kPeakRodSpeed = 0.19;  // [m/s] the step test's, as above
   std::smatch m;

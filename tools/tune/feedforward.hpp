@@ -11,8 +11,10 @@
 // feedback hands the tracking over to it. Not at the lowest lines: there
 // the small excitation moves the rod slowly, and the leakage under the
 // load's pressure and the bearing's friction take a larger share of the
-// flow (the simulated quarter car: 0.18 m/s at 0.5 Hz, 0.31 at 10 Hz; its
-// 50 mm step extends at about 0.36 and retracts at 0.25 per unit command).
+// flow (the simulated quarter car: 0.18 m/s at 0.5 Hz, 0.31 at 10 Hz; on
+// its 50 mm step, read 0.2 s into the rise and the fall from the tracked
+// demand's speed over the valve command, about 0.36 extending and 0.25
+// retracting).
 // One K_v for both edges of an asymmetric cylinder: the PI corrects the rest.
 #pragma once
 

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "config/rig_config.hpp"
+#include "tools/tune/loop_gains.hpp"
 
 namespace rigctl {
 
@@ -33,17 +34,13 @@ bool top_level(const std::string& line) {
   return !line.empty() && line[0] != ' ' && line[0] != '\t' && line[0] != '#';
 }
 
-// The controller section's value check: what a loader reads back.
+// The controller section's value check: what a loader reads back, in the
+// keys and units LoopGains writes them (one mapping of keys to fields).
 void check_loaded(const std::string& text, const std::string& name, const std::map<std::string, double>& values) {
-  const RigConfig c = parse_rig_config(text, name);
+  const auto loaded = LoopGains::from_config(parse_rig_config(text, name)).config_values();
   for (const auto& [key, v] : values) {
-    const double got = key == "kp" && c.controller.type == ControllerKind::kPi ? c.controller.pi.kp
-                       : key == "ki"                                      ? c.controller.pi.ki
-                       : key == "velocity_feedforward"                    ? c.controller.pi.velocity_feedforward
-                       : key == "ke"                                      ? c.controller.pvp.ke
-                       : key == "kv"                                      ? c.controller.pvp.kv
-                       : key == "kp_v_per_bar"                            ? c.controller.pvp.kp * 1e5
-                                                                          : NAN;
+    const auto it = loaded.find(key);
+    const double got = it == loaded.end() ? NAN : it->second;
     if (!(std::abs(got - v) <= 1e-5 * std::max(1.0, std::abs(v)))) {
       throw std::runtime_error(name + ": controller." + key + " did not load back as " + number(v));
     }
