@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "plant/quarter_car/quarter_car_step_size.hpp"
 #include "plant/servo_valve.hpp"
@@ -43,6 +44,12 @@ QuarterCarPlant::QuarterCarPlant(const QuarterCarParams& params)
                {"p2", "Pa"},       {"f_t", "N"},          {"sim_v_r", "m/s"},
                {"sim_x_s", "1"},   {"sim_f_bearing", "N"}, {"sim_bearing_stuck", "1"}},
       commands_{{"u", "1"}} {
+  // One bearing friction law at a time: the stick/slip sub-step would never
+  // advance the LuGre bristles (substep() below).
+  if (params.hidden.bearing_lugre && params.bearing_friction.enabled) {
+    throw std::invalid_argument("quarter car: the LuGre bearing friction (hidden.bearing_lugre) and the stick/slip "
+                                "bearing friction (bearing_friction.enabled) cannot both be on");
+  }
   reset();
 }
 

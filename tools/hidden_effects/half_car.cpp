@@ -80,7 +80,8 @@ AppliedEffect apply(RigConfig& c, const std::string& cause, double level, int fo
     a.form = form == 0 ? "piecewise_linear" : "digressive";
     // The fit's c (1 +- asym) with c the mean: asym = (f - 1) / (f + 1).
     a.truth = {{"asym", (f - 1.0) / (f + 1.0)}, {"rebound_factor", f}};
-    a.description = "piecewise-linear dampers, rebound " + std::to_string(f) + " x compression";
+    a.description = std::string(form == 0 ? "piecewise-linear" : "digressive (knee at 0.1 m/s)") + " dampers, rebound " +
+                    std::to_string(f) + " x compression";
     return a;
   }
   if (cause == "tyre_liftoff") {
@@ -118,7 +119,8 @@ AppliedEffect apply(RigConfig& c, const std::string& cause, double level, int fo
     }
     a.form = form == 0 ? "pure_delay" : "butterworth_filter";
     a.truth = {{"tau", tau}};
-    a.description = "z_s, phi, z_u1, z_u2 transducers delayed by " + std::to_string(tau) + " s (cubic interpolation)";
+    a.description = "z_s, phi, z_u1, z_u2 transducers delayed by " + std::to_string(tau) + " s" +
+                    (form == 0 ? " (cubic interpolation)" : " (2nd-order Butterworth conditioning filter)");
     return a;
   }
   throw std::invalid_argument("half_car: no hidden effect '" + cause + "'");

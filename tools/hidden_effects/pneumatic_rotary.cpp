@@ -147,7 +147,8 @@ AppliedEffect apply(RigConfig& c, const std::string& cause, double level, int fo
     a.form = form == 0 ? "sharp" : "rounded";
     a.truth = {{"delta", kOverlapV * level}, {"overlap_m", p.valve_overlap}};
     a.description = "spool overlap " + std::to_string(p.valve_overlap * 1e3) + " mm (" +
-                    std::to_string(kOverlapV * level) + " V of command): sharp dead band";
+                    std::to_string(kOverlapV * level) + " V of command): " +
+                    (form == 0 ? "sharp lands" : "rounded metering edges");
     return a;
   }
   if (cause == "sensor_delay") {
@@ -158,7 +159,8 @@ AppliedEffect apply(RigConfig& c, const std::string& cause, double level, int fo
     }
     a.form = form == 0 ? "pure_delay" : "butterworth_filter";
     a.truth = {{"tau", tau}};
-    a.description = "theta, dp and omega transducers delayed by " + std::to_string(tau * 1e3) + " ms";
+    a.description = "theta, dp and omega transducers delayed by " + std::to_string(tau * 1e3) + " ms" +
+                    (form == 0 ? " (cubic interpolation)" : " (2nd-order Butterworth conditioning filter)");
     return a;
   }
   throw std::invalid_argument("pneumatic_rotary: no hidden effect '" + cause + "'");

@@ -17,6 +17,7 @@
 #include <stdexcept>
 
 #include "drivers/sim/conditioning_filter.hpp"
+#include "plant/quarter_car/hidden_effect_laws.hpp"
 #include "tools/hidden_effects/perturbation.hpp"
 #include "tools/hidden_effects/rigs.hpp"
 
@@ -47,7 +48,8 @@ AppliedEffect apply(RigConfig& c, const std::string& cause, double level, int fo
     b.viscous *= level;
     b.normal_coefficient *= level;
     a.truth = {{"Fc", b.coulomb_base}, {"dFs", b.stiction_excess}, {"D", b.viscous}};
-    a.description = "body-bearing Karnopp stick/slip friction at the nominal levels x level";
+    a.description = form == 0 ? "body-bearing Karnopp stick/slip friction at the nominal levels x level"
+                              : "body-bearing LuGre bristle friction at the nominal levels x level";
   } else if (cause == "actuator_seal_friction") {
     // 150 N preload + 5e-6 N/Pa x (p1 + p2) (about 100 N at the ~200 bar sum):
     // about 1 % of the ~20 kN rod force of a step (A1 p1).
@@ -57,7 +59,8 @@ AppliedEffect apply(RigConfig& c, const std::string& cause, double level, int fo
     h.seal_form = form;
     a.form = form == 0 ? "simscape" : "exponential_stribeck";
     a.truth = {{"F_pr", h.seal_preload}, {"f_c", h.seal_pressure_coefficient}, {"viscous", h.seal_viscous}};
-    a.description = "rod seal friction, Simscape cylinder-friction form (Stribeck peak 1.3 x Coulomb at 20 mm/s)";
+    a.description = form == 0 ? "rod seal friction, Simscape cylinder-friction form (Stribeck peak 1.3 x Coulomb at 20 mm/s)"
+                              : "rod seal friction, exponential Stribeck law on a 1 mm/s Coulomb step, plus viscous";
   } else if (cause == "cross_port_leakage") {
     // A worn piston seal: turbulent leak of 2 x the nominal laminar leak at 50 bar.
     // Form 1 splits the same extra flow at 50 bar half laminar, half turbulent.
@@ -67,24 +70,26 @@ AppliedEffect apply(RigConfig& c, const std::string& cause, double level, int fo
     h.extra_laminar_leak = (1.0 - turbulent_share) * 2.0 * level * nominal_at_50bar / 50e5;
     a.form = form == 0 ? "turbulent" : "laminar_and_turbulent";
     a.truth = {{"K_orifice", h.worn_seal_orifice}, {"extra_leak_at_50bar_m3_s", 2.0 * level * nominal_at_50bar}};
-    a.description = "turbulent cross-port leak through a worn piston seal, K sign(dp) sqrt|dp|";
+    a.description = form == 0 ? "turbulent cross-port leak through a worn piston seal, K sign(dp) sqrt|dp|"
+                              : "cross-port leak through a worn piston seal, half laminar, half turbulent at 50 bar";
   } else if (cause == "valve_deadband") {
     h.valve_overlap = 0.05 * level;  // 5 % of rated spool travel: a lapped, worn-in spool
     h.valve_overlap_edge_radius = form == 0 ? 0.0 : 0.5 * h.valve_overlap;  // worn, rounded lands
     a.form = form == 0 ? "sharp" : "rounded";
     a.truth = {{"overlap", h.valve_overlap}};
-    a.description = "sharp spool overlap (no metering inside +-overlap)";
+    a.description = form == 0 ? "sharp spool overlap (no metering inside +-overlap)"
+                              : "spool overlap with rounded metering edges (radius half the overlap)";
   } else if (cause == "entrained_air") {
     // alpha 0.15 at atmosphere: -27 % bulk modulus at the cap side's ~75 bar.
     // Adiabatic bubbles are stiffer: a little more air for a like size.
     h.air_fraction = (form == 0 ? 0.15 : 0.2) * level;
     h.air_polytropic_index = form == 0 ? 1.0 : 1.4;
     a.form = form == 0 ? "isothermal" : "adiabatic";
-    QuarterCarParams p = c.quarter_car;
-    const double pabs = 101325.0 + 75e5, pa = 101325.0, e = p.bulk_modulus, al = h.air_fraction;
-    const double e75 = e * (1.0 + al * pa / pabs) / (1.0 + al * pa * e / (pabs * pabs));
+    const double e = c.quarter_car.bulk_modulus;
+    const double e75 = mixture_bulk_modulus(e, h.air_fraction, h.air_polytropic_index, 75e5);  // the plant's own law
     a.truth = {{"air_fraction", h.air_fraction}, {"beta_at_75bar", e75}, {"beta_ratio_at_75bar", e75 / e}};
-    a.description = "free air in the oil: pressure-dependent effective bulk modulus (isothermal mixture law)";
+    a.description = std::string("free air in the oil: pressure-dependent effective bulk modulus (") +
+                    (form == 0 ? "isothermal" : "adiabatic") + " mixture law)";
   } else if (cause == "sensor_delay") {
     // 6 ms strong (2.4 periods; an LVDT demodulator filter): not a whole number of samples.
     // Form 1: a conditioning filter of the same low-frequency group delay.
@@ -95,13 +100,14 @@ AppliedEffect apply(RigConfig& c, const std::string& cause, double level, int fo
     }
     a.form = form == 0 ? "pure_delay" : "butterworth_filter";
     a.truth = {{"tau", tau}};
-    a.description = "x_w and x_b transducers late by tau (cubic interpolation of the true signal's history)";
+    a.description = form == 0 ? "x_w and x_b transducers late by tau (cubic interpolation of the true signal's history)"
+                              : "x_w and x_b through a 2nd-order Butterworth conditioning filter of group delay tau";
   } else if (cause == "sensor_offset") {
     const double b = 2e-3 * level;  // 2 mm on an LVDT: a zero not reset after a fixture change
     c.sensors[form == 0 ? "x_b" : "x_w"].offset = form == 0 ? b : -b;
     a.form = form == 0 ? "body_lvdt" : "wheel_lvdt";
     a.truth = {{form == 0 ? "b_b" : "b_w", form == 0 ? b : -b}};
-    a.description = "offset on the x_b transducer";
+    a.description = form == 0 ? "offset on the x_b transducer" : "offset on the x_w transducer";
   } else if (cause == "tyre_liftoff") {
     // Lift-off is physics, not a switch: a real tyre never pulls, and the
     // clean excitation never unloads it (lowest load ~0.3 kN). The effect is
@@ -122,7 +128,8 @@ AppliedEffect apply(RigConfig& c, const std::string& cause, double level, int fo
     h.tyre_damping_in_contact_only = form == 1;
     a.form = form == 0 ? "no_pull" : "no_pull_no_damper";
     a.truth = {{"pull_loss", h.tyre_pull_loss}};
-    a.description = "wheel-hop burst in the demand and a tyre that cannot pull (weak: part of the pull lost)";
+    a.description = form == 0 ? "wheel-hop burst in the demand and a tyre that cannot pull (weak: part of the pull lost)"
+                              : "wheel-hop burst in the demand, a tyre that cannot pull and whose damping acts only in contact";
   } else if (cause == "damper_asymmetry") {
     // Rebound 1.6 x, compression 0.4 x the nominal 260 N s/m (strong): a
     // typical road damper's rebound/compression ratio of 3-4.
@@ -136,7 +143,8 @@ AppliedEffect apply(RigConfig& c, const std::string& cause, double level, int fo
     a.truth = {{"c_rebound", bd * h.damper_rebound_factor},
                {"c_compression", bd * h.damper_compression_factor},
                {"dc", 0.5 * bd * (h.damper_compression_factor - h.damper_rebound_factor)}};
-    a.description = "piecewise-linear damper: rebound and compression coefficients differ";
+    a.description = form == 0 ? "piecewise-linear damper: rebound and compression coefficients differ"
+                              : "damper with a progressive rebound valve: rebound and compression coefficients differ";
   } else {
     throw std::invalid_argument("quarter_car has no effect '" + cause +
                                 "' (bearing_friction, actuator_seal_friction, cross_port_leakage, valve_deadband, "

@@ -54,6 +54,23 @@ TEST(QuarterCarPlant, AdvanceAndMeasureDoNotAllocate) {
   EXPECT_EQ(rigctl::test::allocation_count() - before, 0);
 }
 
+// Two bearing friction laws at once would leave the LuGre bristles frozen
+// under the stick/slip sub-step: refused with both names.
+TEST(QuarterCarPlant, LugreAndStickSlipBearingFrictionTogetherAreRefused) {
+  QuarterCarParams p;
+  p.bearing_friction.enabled = true;
+  p.hidden.bearing_lugre = true;
+  try {
+    QuarterCarPlant plant(p);
+    ADD_FAILURE() << "accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("bearing_lugre"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("bearing_friction.enabled"), std::string::npos) << e.what();
+  }
+  p.bearing_friction.enabled = false;
+  EXPECT_NO_THROW(QuarterCarPlant{p});
+}
+
 TEST(QuarterCarPlant, CommandSaturatesAtRatedCurrent) {
   QuarterCarPlant a{QuarterCarParams{}}, b{QuarterCarParams{}};
   run(a, 1.0, 0.1);

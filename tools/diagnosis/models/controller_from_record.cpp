@@ -55,6 +55,7 @@ std::string calibrate_pi(PiConfig& pi, const std::vector<double>& x_ref, const s
                          const std::vector<double>& u) {
   const std::size_t n = u.size();
   std::vector<std::vector<double>> X(2, std::vector<double>(n));
+  std::vector<double> u_feedback(n);  // the command less the config's demand feedforward (not regressed)
   std::vector<bool> use(n, true);
   double sum = 0.0;
   bool saturated = false;
@@ -63,12 +64,14 @@ std::string calibrate_pi(PiConfig& pi, const std::vector<double>& x_ref, const s
     sum += e * pi.period_s;
     X[0][i] = e;
     X[1][i] = sum;
+    const double demand_rate = i > 0 ? (x_ref[i] - x_ref[i - 1]) / pi.period_s : 0.0;
+    u_feedback[i] = u[i] - pi.velocity_feedforward * demand_rate;
     saturated = saturated || std::abs(u[i]) >= 0.999 * pi.output_limit;  // anti-windup changes the sum after it
     use[i] = !saturated;
   }
   Eigen::VectorXd cfg(2);
   cfg << pi.kp, pi.ki;
-  const auto r = regress(X, u, use, cfg);
+  const auto r = regress(X, u_feedback, use, cfg);
   if (!prefer_record(r)) return "PI gains of the config (kp " + num(pi.kp) + ", ki " + num(pi.ki) + ")";
   pi.kp = r.coef(0);
   pi.ki = r.coef(1);
