@@ -108,6 +108,9 @@ TEST(CommissioningQuarterCar, TunedFromAStabiliserMeetsTheTargetAndBeatsTheStart
   // tuned controller does.
   EXPECT_GT(test::gain_of(tuned, "velocity_feedforward"), 0.0);
   EXPECT_LT(step.iae, relay_ziegler_nichols_step(stabiliser, dir, "nominal").iae);
+  // From a config that has a feedforward, the relay's gains still have none
+  // (the helper asserts it): Ziegler-Nichols rules give feedback gains only.
+  relay_ziegler_nichols_step(tuned, dir, "from-tuned");
 }
 
 // Ziegler-Nichols from the relay experiment reach their speed with the

@@ -193,6 +193,20 @@ TEST(DriveIteration, ATargetMissingTheChannelIsRefusedNamingIt) {
   EXPECT_NE(r.output.find("x_b"), std::string::npos) << r.output;
 }
 
+// A band from 0 Hz has no third-octave bands to step through (the update's
+// bands would never end): refused before anything is played.
+TEST(DriveIteration, ABandFromZeroOrAboveNyquistIsRefusedNamingTheOption) {
+  const std::string dir = fresh_dir("bad-band");
+  const std::string target = sine_target(dir, 0.005, 1.0);
+  for (const std::string band : {"--band 0", "--band 5 --band-max 2", "--band-max 250"}) {
+    const auto r = rigctl("iterate " + kConfig + " --target " + target + " --channel x_w --out " + dir + "/out " +
+                          band + " --fast --no-realtime");
+    EXPECT_EQ(r.exit_code, 1) << band << ": " << r.output;
+    EXPECT_NE(r.output.find("--band: needs 0 < low < high"), std::string::npos) << band << ": " << r.output;
+    EXPECT_FALSE(std::filesystem::exists(dir + "/out/summary.json")) << band;
+  }
+}
+
 TEST(DriveIteration, BeyondTheStrokeEndsAtTheStrokeLimitWithoutPlaying) {
   const std::string dir = fresh_dir("stroke");
   // 100 mm about mid-stroke, slowly (63 mm/s): the setpoint range leaves 80 mm either way.

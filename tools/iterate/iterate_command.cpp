@@ -25,8 +25,13 @@ namespace {
 // (the wheel hop, ~24 Hz with 0.3 damping: a 15 Hz wide peak).
 constexpr double kModelStepHz = 0.05;
 
-RigConfig rig_config(const IterateOptions& o) {
-  RigConfig c = load_rig_config(o.config_path, o.case_name);
+// The rig the drives play on: the config's, its PI without a demand
+// feedforward (the drive is the feedforward here, and the FRF the inverse
+// comes from, measured by identify or computed from the model, is the
+// feedback loop's: with a feedforward in, the played loop would not be the
+// inverted one), and the hidden effects of --effect.
+RigConfig rig_config(const IterateOptions& o, RigConfig c) {
+  c.controller.pi.velocity_feedforward = 0.0;
   if (o.effects.empty()) return c;
   if (!is_simulated(c.driver)) throw std::invalid_argument("--effect: only a simulated rig can be given hidden effects");
   const RigEffectGenerator& g = effect_generator(c.rig);
@@ -89,8 +94,14 @@ IterationSummary summary_of(const IterateOptions& o, const RigConfig& rig, const
 IterateResult run_iterate(const IterateOptions& o, const std::atomic<bool>& stop, std::ostream& out) {
   if (o.channel.empty()) throw std::invalid_argument("--channel: the target channel is required");
   const RigConfig nominal = load_rig_config(o.config_path, o.case_name);
-  const RigConfig rig = rig_config(o);
+  const RigConfig rig = rig_config(o, nominal);
   const double dt = rig.loop.period_s;
+  const auto& band = o.settings.inverse;
+  if (!(band.band_min_hz > 0.0 && band.band_max_hz > band.band_min_hz && band.band_max_hz <= 0.5 / dt)) {
+    throw std::invalid_argument("--band: needs 0 < low < high <= " + std::to_string(0.5 / dt) +
+                                " Hz (half the loop's rate), got " + std::to_string(band.band_min_hz) + " " +
+                                std::to_string(band.band_max_hz));
+  }
   const std::vector<double> target = read_target(o.target_path, o.channel, dt);
   const double op = std::accumulate(target.begin(), target.end(), 0.0) / static_cast<double>(target.size());
   const IterationSettings& s = o.settings;

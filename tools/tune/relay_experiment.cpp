@@ -69,6 +69,7 @@ LoopGains ziegler_nichols(LoopGains g, double ku, double tu) {
   if (g.kind == ControllerKind::kPi) {
     g.kp = 0.45 * ku;
     g.ki = g.kp / (tu / 1.2);
+    g.kff = 0.0;  // the rules are for the feedback gains; a feedforward of another design does not carry over
   } else {
     g.ke = 0.6 * ku;
     g.kv = g.ke * tu / 8.0;
