@@ -27,11 +27,14 @@ class LatestValveActual {
   }
   // The two halves of store(). Between them readers get no copy: what a
   // writer preempted inside a store looks like to them (tests hold it open).
+  // finish_store() alone (no store open) is a whole store: it cannot leave
+  // the counter odd for good.
   void begin_store() noexcept {
     seq_.store(seq_.load(std::memory_order_relaxed) | 1U, std::memory_order_relaxed);  // odd: write in progress
     std::atomic_thread_fence(std::memory_order_release);
   }
   void finish_store(const ValveActual& a) noexcept {
+    if ((seq_.load(std::memory_order_relaxed) & 1U) == 0) begin_store();
     rx_ns_.store(a.rx_ns, std::memory_order_relaxed);
     count_.store(a.count, std::memory_order_relaxed);
     status_word_.store(a.status_word, std::memory_order_relaxed);

@@ -42,7 +42,9 @@ void CanopenValve::io_loop() {
     // Wake for our next heartbeat or null setpoint, and at least every 5 ms
     // to poll the consumer timeout and the stop request.
     const int64_t next = std::min(producer_.next_due_ns(), next_keepalive_ns_);
-    service(static_cast<int>(std::clamp<int64_t>((next - clock_ns()) / 1'000'000, 0, 5)));
+    // Rounded up: rounded down, the last millisecond before a deadline
+    // would poll with a zero timeout again and again (a spin at SCHED_FIFO).
+    service(static_cast<int>(std::clamp<int64_t>((next - clock_ns() + 999'999) / 1'000'000, 0, 5)));
     repeat_null_setpoint(clock_ns());
   }
 }
@@ -207,7 +209,7 @@ void CanopenValve::on_heartbeat(const Heartbeat& hb, int64_t now_ns) {
   last_heartbeat_ns_.store(now_ns, std::memory_order_release);
   valve_state_.store(static_cast<uint8_t>(hb.state), std::memory_order_release);
   using E = HeartbeatConsumer::Event;
-  const std::string state = nmt_state_name(hb.state);
+  const char* const state = nmt_state_name(hb.state);  // strings are built only for an event
   switch (consumer_.on_heartbeat(hb, now_ns)) {
     case E::kResetAfterOperational:
       counters_.valve_resets.fetch_add(1, std::memory_order_relaxed);

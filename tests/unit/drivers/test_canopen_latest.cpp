@@ -49,6 +49,17 @@ TEST(LatestValveActual, WhileTheWriterIsInsideAStoreTheReaderKeepsItsPreviousCop
   EXPECT_EQ(kept.spool, 0.4);
 }
 
+TEST(LatestValveActual, AFinishWithoutABeginIsAWholeStore) {
+  LatestValveActual latest;
+  latest.finish_store(actual(3, 900, 0.1));
+  ValveActual a;
+  ASSERT_TRUE(latest.load(a)) << "the counter must not stay odd";
+  EXPECT_EQ(a.count, 3U);
+  latest.store(actual(4, 1000, 0.2));
+  ASSERT_TRUE(latest.load(a));
+  EXPECT_EQ(a.count, 4U);
+}
+
 TEST(LatestValveActual, AReaderThatNeverHadACopyStillHasNone) {
   LatestValveActual latest;
   ValveActual kept;
