@@ -1,4 +1,5 @@
 #include "foxglove/console/console_gateway.hpp"
+#include "rt/wall_clock.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -10,11 +11,6 @@ namespace rigctl::foxglove {
 using nlohmann::json;
 
 namespace {
-
-int64_t wall_utime() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
 
 const char* const kAnswerSchema = R"({"type":"object","properties":{
   "id":{"type":"number"},"command":{"type":"string"},"sequence":{"type":"number"},
@@ -94,7 +90,7 @@ ConsoleGateway::Answer ConsoleGateway::handle(uint64_t client, const std::string
     return a;
   }
   if (a.command == kTakeControlCommand) {
-    const ControlAnswer c = control_.claim(client, msg, wall_utime());
+    const ControlAnswer c = control_.claim(client, msg, wall_utime_now());
     a.reason = c.reason;
     a.message = c.ok() ? "this console holds control" : c.detail;
     if (c.ok()) announce_control();
@@ -116,7 +112,7 @@ ConsoleGateway::Answer ConsoleGateway::handle(uint64_t client, const std::string
 void ConsoleGateway::send_answer(uint64_t client, const Answer& a) {
   const json j{{"id", a.id},         {"command", a.command}, {"sequence", a.sequence},
                {"accepted", a.reason == "accepted"}, {"reason", a.reason},   {"message", a.message}};
-  server_.publish_to(client, answer_channel_, static_cast<uint64_t>(wall_utime()) * 1000,
+  server_.publish_to(client, answer_channel_, static_cast<uint64_t>(wall_utime_now()) * 1000,
                      std::make_shared<const std::string>(j.dump()));
 }
 

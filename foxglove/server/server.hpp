@@ -33,8 +33,9 @@ inline constexpr const char* kSubprotocols[] = {"foxglove.websocket.v1", "foxglo
 struct ServerOptions {
   std::string address = "127.0.0.1";  // loopback unless the operator says otherwise
   uint16_t port = 8765;               // 0: any free port (port() tells which)
-  // A client's queue in messages. 1024 is half a second of every channel at
-  // 400 Hz: a client further behind than that is shown fresh data rather
+  // A client's queue in messages. 1024 is 0.85 s of telemetry at 400 Hz
+  // (sample, command and controller each tick: 1200 a second, plus the
+  // timing and state messages): a client further behind than that is shown fresh data rather
   // than an ever older backlog (and the server's memory stays bounded).
   std::size_t client_queue_messages = 1024;
   std::string name = "rigctl";

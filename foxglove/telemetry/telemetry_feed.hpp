@@ -34,6 +34,7 @@ class TelemetryFeed final : public TelemetryTap {
   std::map<TelemetryTopic, uint32_t> channel_ids_;  // advertised so far
   RigStatus status_;
   std::atomic<int64_t> undecodable_{0};
+  std::atomic<int64_t> unserved_{0};  // messages whose serving threw (warned once per 10000)
 };
 
 }  // namespace rigctl::foxglove

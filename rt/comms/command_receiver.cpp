@@ -1,6 +1,7 @@
 // Operator command receiver thread: LCM in, verified commands to the loop's
 // queue, acks out, rejections logged.
 #include "rt/comms/command_receiver.hpp"
+#include "rt/wall_clock.hpp"
 
 #include <chrono>
 #include <stdexcept>
@@ -11,10 +12,6 @@
 namespace rigctl {
 
 namespace {
-
-int64_t wall_utime() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
-}
 
 // LCM treats a subscription's channel as a regular expression: match the
 // configured name literally.
@@ -80,14 +77,14 @@ void CommandReceiver::run() {
 }
 
 void CommandReceiver::on_message(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
-  const int64_t now = wall_utime();
+  const int64_t now = wall_utime_now();
   const DecodedCommand d = accept(rbuf->data, rbuf->data_size, now);
   // Nothing to address a reply to when the message did not decode as far as
   // its sender id.
   if (!d.sender.empty() && valid_sender_id(d.sender)) reply(d, now);
 }
 
-DecodedCommand CommandReceiver::submit(const void* data, std::size_t size) { return accept(data, size, wall_utime()); }
+DecodedCommand CommandReceiver::submit(const void* data, std::size_t size) { return accept(data, size, wall_utime_now()); }
 
 DecodedCommand CommandReceiver::accept(const void* data, std::size_t size, int64_t now) {
   std::lock_guard<std::mutex> lock(producer_mu_);

@@ -1,4 +1,5 @@
 #include "rt/comms/event_log.hpp"
+#include "rt/wall_clock.hpp"
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -30,11 +31,6 @@ std::string iso_utc(int64_t utime) {
   const std::size_t n = std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%S", &tm);
   std::snprintf(buf + n, sizeof buf - n, ".%06lldZ", static_cast<long long>(utime % 1'000'000));
   return buf;
-}
-
-int64_t wall_utime() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
 }
 
 }  // namespace
@@ -154,7 +150,7 @@ void EventLog::drain() {
 
 void EventLog::start() {
   if (thread_.joinable()) return;
-  pending_.push_back("# rigctl event log: rig " + meta_.rig + ", opened " + iso_utc(wall_utime()) +
+  pending_.push_back("# rigctl event log: rig " + meta_.rig + ", opened " + iso_utc(wall_utime_now()) +
                      "; one line per event: wall time (UTC), rig time t [s], tick, state after the event, code, "
                      "channel, value, source, message; a full queue: " +
                      (meta_.queue_policy == QueueFullPolicy::kWait ? std::string("the loop waits (simulated time)")
@@ -185,7 +181,7 @@ void EventLog::stop() {
   running_.store(false);
   if (thread_.joinable()) thread_.join();
   drain();
-  pending_.push_back("# closed cleanly " + iso_utc(wall_utime()) + ": " + std::to_string(written_.load()) +
+  pending_.push_back("# closed cleanly " + iso_utc(wall_utime_now()) + ": " + std::to_string(written_.load()) +
                      " lines written, " + std::to_string(queue_.dropped()) + " dropped");
   flush_pending();
   if (fd_ >= 0) ::close(fd_);

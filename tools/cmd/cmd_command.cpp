@@ -1,5 +1,6 @@
 // `rigctl cmd`: one signed operator command out, one verified ack back.
 #include "tools/cmd/cmd_command.hpp"
+#include "rt/wall_clock.hpp"
 
 #include <fcntl.h>
 #include <sys/file.h>
@@ -22,10 +23,6 @@
 namespace rigctl {
 
 namespace {
-
-int64_t wall_utime() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
-}
 
 // USER@HOSTNAME with anything outside the sender alphabet replaced by '_'.
 std::string default_sender() {
@@ -188,7 +185,7 @@ int run_cmd_command(const CmdOptions& o, std::ostream& out, std::ostream& err) {
     msg.sender = sender;
     msg.command = name;
     msg.value = value;
-    msg.utime = wall_utime();
+    msg.utime = wall_utime_now();
     msg.sequence = reserve_sequence(o.state_path.empty() ? default_sequence_state_path(sender) : o.state_path, msg.utime);
     sign(msg, key);
     const auto bytes = lcm_encode(msg);

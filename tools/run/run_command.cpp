@@ -1,4 +1,5 @@
 #include "tools/common/stage_text.hpp"
+#include "rt/wall_clock.hpp"
 #include "tools/run/run_command.hpp"
 
 #include <spdlog/spdlog.h>
@@ -31,11 +32,6 @@
 namespace rigctl {
 
 namespace {
-
-int64_t wall_utime_now() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
 
 std::string default_log_path(const std::string& dir, const std::string& rig) {
   const std::time_t now = std::time(nullptr);
@@ -98,7 +94,6 @@ std::unique_ptr<foxglove::TelemetryServer> make_foxglove_server(const RigConfig&
                  {foxglove::kStationMetadataKey, foxglove::station_json(station)}};
   return std::make_unique<foxglove::TelemetryServer>(so, config.telemetry.channel_prefix, rig_parameters(config));
 }
-
 
 // The run's own parts over the config's (the commissioning commands'
 // demand and controller), the --fast check and the injected faults.
@@ -209,7 +204,6 @@ void print_run_summary(const RigConfig& config, const RunOptions& options, const
   }
   if (result.dropped_records > 0) out << "  telemetry records dropped: " << result.dropped_records << "\n";
 }
-
 
 // The operator's command receiver of an operator-mode run, on the run's LCM
 // URL, with the unit of the setpoint commands (the loop's feedback input).

@@ -66,6 +66,12 @@ class FoxgloveServer : public ::testing::Test {
 };
 
 TEST_F(FoxgloveServer, ClientsOfBothSubprotocolsGetEverySampleInOrderAsInTheLog) {
+  // Every sample, so no client may fall a whole queue behind: the shipped
+  // 1024 messages are 0.85 s, which a Node client stalled on a loaded 2-core
+  // machine can lose (the dropping itself is AClientThatStopsReading...'s
+  // test). 12000 messages are 10 s.
+  write_config("quarter_car.yaml", edit(without_overrun_stop(shipped_config()), "  # websocket: \\{port: 8765\\}",
+                                        "  websocket: {port: 8765, client_queue: 12000}"));
   const int port = free_tcp_port();
   const char* protocols[] = {"foxglove.websocket.v1", "foxglove.sdk.v1"};
   std::vector<std::unique_ptr<BackgroundProcess>> clients;
