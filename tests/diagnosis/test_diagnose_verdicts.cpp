@@ -150,6 +150,29 @@ TEST(DiagnoseVerdicts, TwoCandidatesThatExplainTheResidualAlikeAreReportedAmbigu
   EXPECT_NE(json_of(d).find("\"ambiguous_with\": [\"" + other + "\"]"), std::string::npos);
 }
 
+// An offset of 6 noise sigmas gains under 1 pp on y (it is 0.9 % of y's
+// spread), but it is the whole misfit: the baseline misfits 6 x its noise,
+// the offset takes it to the noise. Named through the lower floor; with the
+// full g_min for every candidate, the same run is only `unexplained`.
+TEST(DiagnoseVerdicts, ASmallEffectThatIsTheWholeMisfitIsNamed) {
+  Truth t;
+  t.offset = 0.012;
+  LagModel m(t);
+  const auto d = diagnose(m, {});
+  ASSERT_FALSE(d.causes.empty()) << "unexplained: " << d.unexplained;
+  const auto& top = d.causes.front();
+  EXPECT_TRUE(top.cause == "offset_a" || top.cause == "offset_b") << top.cause;
+  EXPECT_LT(top.gain_percent_points, 1.0) << "the case is meant to be below g_min";
+  EXPECT_GT(top.gain_percent_points, DiagnoseOptions{}.explained_min_gain);
+  EXPECT_NEAR(top.parameters[0].value, 0.012, 0.002);
+
+  DiagnoseOptions full_floor;
+  full_floor.explained_min_gain = full_floor.min_gain;
+  const auto strict = diagnose(m, full_floor);
+  EXPECT_EQ(strict.cause, "none");
+  EXPECT_TRUE(strict.unexplained);
+}
+
 TEST(DiagnoseVerdicts, AMisfitNoCandidateExplainsIsUnexplainedWithItsBand) {
   Truth t;
   t.hum = 0.04;  // 20 noise sigmas at 7 Hz, which no candidate can make

@@ -32,7 +32,9 @@ struct Candidate {
   Scored s;
   std::size_t signal = 0;
   double gain = 0.0, se = 0.0;
-  std::string reason;  // empty: passes
+  double excess_before = 0.0, excess_after = 0.0;  // its signal's held-out rms / noise floor
+  bool explains_misfit = false;                    // criteria.hpp explains_misfit
+  std::string reason;                              // empty: passes
 };
 
 // ------------------------------------------------------------ calibration
@@ -53,7 +55,8 @@ Scored calibrate_baseline(Workspace& w, Diagnosis& d) {
         " iterations");
   for (std::size_t i = 0; i < w.n_base; ++i) {
     const auto& sp = w.specs[i];
-    Calibrated c{sp.name, sp.unit, sp.init, base.theta[i], base.sigma[i], sp.prior, !base.undetermined[i], false};
+    Calibrated c{sp.name, sp.unit, sp.init, base.theta[i], base.sigma[i], sp.prior, !base.undetermined[i], false, {},
+                 false};
     c.moved = sp.prior > 0.0 && std::abs(c.value - c.nominal) >= 0.5 * sp.prior * std::abs(c.nominal);
     if (!sp.stands_for.empty()) {
       // Within a twentieth of a tolerance of the edge the workspace set.
@@ -146,6 +149,28 @@ std::vector<Candidate> screen(const Workspace& w, const Scored& current, const s
   return out;
 }
 
+// Held-out residual rms of output o over the record's noise floor on it.
+double held_out_excess(const Workspace& w, const Scored& s, std::size_t o, double* rms_out = nullptr) {
+  const auto e = w.residual(s, o);
+  double ss = 0.0;
+  for (std::size_t i = w.val_begin; i < w.n; ++i) ss += e[i] * e[i];
+  const double rms = std::sqrt(ss / static_cast<double>(std::max<std::size_t>(1, w.n - w.val_begin)));
+  if (rms_out) *rms_out = rms;
+  const double noise = noise_floor(w.outs()[o].measured);
+  return noise > 0.0 ? rms / noise : 0.0;
+}
+
+// The gain a model `with` an effect must show over one `without` it on
+// output o: g_min, or explained_min_gain where it explains a misfit beyond
+// the noise (criteria.hpp).
+double gain_floor(const Workspace& w, const Scored& without, const Scored& with, std::size_t o) {
+  CandidateEvidence ev;
+  ev.excess_before = held_out_excess(w, without, o);
+  ev.excess_after = held_out_excess(w, with, o);
+  ev.fit_before = without.fit[o];
+  return explains_misfit(ev) ? w.options.explained_min_gain : w.options.min_gain;
+}
+
 bool strength_significant(const Workspace& w, std::size_t e, const Scored& s) {
   for (std::size_t j = 0; j < w.effects[e].params.size(); ++j) {
     const auto& ps = w.effects[e].params[j];
@@ -170,16 +195,28 @@ Candidate refit_one(const Workspace& w, const Candidate& screened, const Scored&
   // sub-model's outputs do not change with the candidate).
   r.s = fit_coupled(w, screened.s.theta, act, 30, current);
   w.say("  " + cause + ": refitted in " + std::to_string(r.s.iterations) + " iterations");
+  // Its signal: the largest gain among the outputs where it reaches its
+  // floor (a delay may gain most on dp but explain the misfit of theta),
+  // else the largest gain.
   r.gain = -1e9;
-  for (std::size_t o = 0; o < w.outs().size(); ++o)
-    if (r.s.fit[o] - current.fit[o] > r.gain) r.gain = r.s.fit[o] - current.fit[o], r.signal = o;
-  const auto fits = bootstrap_fits(w.outs()[r.signal].measured, {&current.y[r.signal], &r.s.y[r.signal]},
-                                   w.val_begin, w.n, 200, 777);
+  bool reaches = false;
+  for (std::size_t o = 0; o < w.outs().size(); ++o) {
+    const double g = r.s.fit[o] - current.fit[o];
+    const bool here = g >= gain_floor(w, current, r.s, o);
+    if ((here && !reaches) || (here == reaches && g > r.gain)) r.gain = g, r.signal = o, reaches = here;
+  }
+  const auto& sig = r.signal;
+  const auto fits = bootstrap_fits(w.outs()[sig].measured, {&current.y[sig], &r.s.y[sig]}, w.val_begin, w.n, 200,
+                                   777, 10, activity_strata(current.y[sig], r.s.y[sig], w.val_begin, w.n));
   r.se = gain_standard_error(fits, 1, 0);
   CandidateEvidence ev{r.gain, r.se, strength_significant(w, r.effect, r.s),
                        bic(r.s.est_sse, w.parameter_count(act), neff, w.n_est_values),
-                       bic(current.est_sse, w.parameter_count(active), neff, w.n_est_values)};
+                       bic(current.est_sse, w.parameter_count(active), neff, w.n_est_values),
+                       held_out_excess(w, current, sig), held_out_excess(w, r.s, sig), current.fit[sig]};
   r.reason = rejection(ev, w.options);
+  r.excess_before = ev.excess_before;
+  r.excess_after = ev.excess_after;
+  r.explains_misfit = explains_misfit(ev);
   return r;
 }
 
@@ -205,7 +242,10 @@ std::vector<Candidate> refit_best(const Workspace& w, std::vector<Candidate> scr
       sc.gain_percent_points = r.gain;
       sc.signal = w.outs()[r.signal].name;
       sc.reason = r.reason.empty() ? "passes" : r.reason;
-      w.say("  " + sc.cause + ": gain " + fmt(r.gain, 3) + " pp on " + sc.signal + " (" + sc.reason + ")");
+      std::string misfit;
+      if (r.explains_misfit)
+        misfit = "; residual " + fmt(r.excess_before, 3) + " -> " + fmt(r.excess_after, 3) + " x its noise floor";
+      w.say("  " + sc.cause + ": gain " + fmt(r.gain, 3) + " pp on " + sc.signal + " (" + sc.reason + misfit + ")");
     }
     d.screened.push_back(sc);
   }
@@ -227,7 +267,8 @@ const Candidate* choose(const Workspace& w, const std::vector<Candidate>& refits
 }
 
 // Confidence: the share of block-bootstrap resamples of the held-out part
-// in which the winner has the largest gain, and at least g_min.
+// in which the winner has the largest gain, and at least its floor (g_min,
+// or explained_min_gain when it explains a misfit beyond the noise).
 double confidence(const Workspace& w, const Candidate& win, const std::vector<Candidate>& refits,
                   const Scored& current) {
   std::vector<const std::vector<double>*> sims{&current.y[win.signal]};
@@ -237,12 +278,13 @@ double confidence(const Workspace& w, const Candidate& win, const std::vector<Ca
     sims.push_back(&refits[r].s.y[win.signal]);
   }
   const auto fits = bootstrap_fits(w.outs()[win.signal].measured, sims, w.val_begin, w.n, 400, 12345);
+  const double floor = win.explains_misfit ? w.options.explained_min_gain : w.options.min_gain;
   int wins = 0;
   for (const auto& row : fits) {
     std::size_t best = 1;
     for (std::size_t s = 2; s < row.size(); ++s)
       if (row[s] > row[best]) best = s;
-    if (best == wi && row[best] - row[0] >= w.options.min_gain) ++wins;
+    if (best == wi && row[best] - row[0] >= floor) ++wins;
   }
   return static_cast<double>(wins) / static_cast<double>(fits.size());
 }
@@ -258,7 +300,8 @@ CauseResult describe(const Workspace& w, const Candidate& win, const std::vector
   cr.extended_fit_percent = win.s.fit[win.signal];
   cr.gain_percent_points = win.gain;
   for (const auto& r : refits)
-    if (&r != &win && r.gain >= w.options.min_gain && about_equal(r.gain, win.gain, w.options))
+    if (&r != &win && r.gain >= (r.explains_misfit ? w.options.explained_min_gain : w.options.min_gain) &&
+        about_equal(r.gain, win.gain, w.options))
       cr.ambiguous_with.push_back(w.effects[r.effect].cause);
   for (std::size_t j = 0; j < eff.params.size(); ++j) {
     const std::size_t i = w.offset[win.effect] + j;
@@ -301,7 +344,7 @@ CauseResult describe(const Workspace& w, const Candidate& win, const std::vector
 
 // ------------------------------------------------------------ after the rounds
 
-// Every kept effect must still earn g_min with the others in.
+// Every kept effect must still earn its floor with the others in.
 void backward_check(const Workspace& w, std::vector<std::size_t>& active, Scored& current, Diagnosis& d) {
   if (active.size() < 2) return;
   for (std::size_t k = 0; k < active.size();) {
@@ -314,8 +357,12 @@ void backward_check(const Workspace& w, std::vector<std::size_t>& active, Scored
     w.say("backward check: without " + eff.cause);
     const Scored without = fit_coupled(w, start, others, 60, current);
     double best = -1e9;
-    for (std::size_t o = 0; o < w.outs().size(); ++o) best = std::max(best, current.fit[o] - without.fit[o]);
-    if (best < w.options.min_gain) {
+    bool earns = false;
+    for (std::size_t o = 0; o < w.outs().size(); ++o) {
+      best = std::max(best, current.fit[o] - without.fit[o]);
+      earns = earns || current.fit[o] - without.fit[o] >= gain_floor(w, without, current, o);
+    }
+    if (!earns) {
       w.say("  dropped " + eff.cause + " (only " + fmt(best, 3) + " pp given the others)");
       d.causes.erase(std::remove_if(d.causes.begin(), d.causes.end(), [&](auto& r) { return r.cause == eff.cause; }),
                      d.causes.end());
@@ -327,26 +374,22 @@ void backward_check(const Workspace& w, std::vector<std::size_t>& active, Scored
   }
 }
 
-// No cause, but a channel whose held-out residual is four times its noise
-// floor or more (and its fit below 99.5 %, so a channel measured far more
-// finely than it moves does not count): the model is wrong in a way nobody
+// No cause, but a channel that misfits beyond its noise
+// (criteria.hpp misfits_beyond_noise): the model is wrong in a way nobody
 // named.
 void check_unexplained(const Workspace& w, const Scored& current, Diagnosis& d) {
   if (!d.causes.empty()) return;
   const double dt = w.n > 1 ? (w.model.time().back() - w.model.time().front()) / static_cast<double>(w.n - 1) : 1.0;
   double worst = 0.0;
   for (std::size_t o = 0; o < w.outs().size(); ++o) {
-    const auto e = w.residual(current, o);
-    double ss = 0.0;
-    for (std::size_t i = w.val_begin; i < w.n; ++i) ss += e[i] * e[i];
-    const double rms = std::sqrt(ss / static_cast<double>(std::max<std::size_t>(1, w.n - w.val_begin)));
-    const double noise = noise_floor(w.outs()[o].measured);
-    const double excess = noise > 0.0 ? rms / noise : 0.0;
-    if (current.fit[o] < 99.5 && excess > 4.0 && excess > worst) {
+    double rms = 0.0;
+    const double excess = held_out_excess(w, current, o, &rms);
+    if (misfits_beyond_noise(excess, current.fit[o]) && excess > worst) {
       worst = excess;
-      const Band band = power_band(e, dt, w.val_begin, w.n);
+      const Band band = power_band(w.residual(current, o), dt, w.val_begin, w.n);
       d.unexplained = true;
-      d.unexplained_residual = {w.outs()[o].name, rms, noise, band.lo_hz, band.hi_hz, band.peak_hz};
+      d.unexplained_residual = {w.outs()[o].name, rms, noise_floor(w.outs()[o].measured), band.lo_hz, band.hi_hz,
+                                band.peak_hz};
     }
   }
   if (d.unexplained)

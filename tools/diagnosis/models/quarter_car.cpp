@@ -7,8 +7,9 @@
 //    Outputs u, x_r and, where recorded, p1 and p2. Causes:
 //    actuator_seal_friction, cross_port_leakage, valve_deadband, entrained_air.
 //  * Suspension (open-loop replay): the measured x_r drives wheel and body.
-//    Outputs x_b, x_w. Causes: bearing_friction, damper_asymmetry,
-//    sensor_delay, sensor_offset, tyre_liftoff.
+//    Outputs x_b, x_w and, where recorded, the tyre load f_t. Causes:
+//    bearing_friction, damper_asymmetry, sensor_delay, sensor_offset,
+//    tyre_liftoff.
 // An effect of one sub-model leaves the other's outputs unchanged, so the
 // engine's per-signal gain points at the right place; the two exceptions are
 // tyre lift-off (the tyre is in both) and an offset on the x_w transducer
@@ -29,6 +30,8 @@
 namespace rigctl::diag {
 
 namespace {
+
+std::string fmt_bar(double pa) { return std::to_string(static_cast<long>(std::lround(pa / 1e5))); }
 
 // Smooth max(0, x) with a corner of width eps (softplus): the fitted
 // candidates are smooth where the generating physics is sharp.
@@ -52,7 +55,7 @@ enum : std::size_t {
   kTau,                          // sensor_delay
   kBb, kBw,                      // sensor_offset
   kUni,                          // tyre_liftoff
-  kSealPr, kSealPc,              // actuator_seal_friction
+  kSealFm, kSealPc,              // actuator_seal_friction
   kLeak,                         // cross_port_leakage
   kDead,                         // valve_deadband
   kBeta,                         // entrained_air
@@ -61,7 +64,7 @@ enum : std::size_t {
 
 constexpr std::size_t kSuspensionParams[] = {kKs, kBd, kMb, kMw, kKt, kBt, kFc, kDFs, kD, kMu, kDc, kTau, kBb, kBw, kUni};
 constexpr std::size_t kActuatorParams[] = {kMb,  kMw,  kKt,  kBt,    kKv,    kTauR, kBetaNom, kRl, kPs,  kA1,
-                                           kA2,  kBvr, kVd,  kUni,   kSealPr, kSealPc, kLeak, kDead, kBeta, kBw};
+                                           kA2,  kBvr, kVd,  kUni,   kSealFm, kSealPc, kLeak, kDead, kBeta, kBw};
 
 template <std::size_t N>
 std::vector<double> key(const std::vector<double>& th, const std::size_t (&idx)[N]) {
@@ -124,10 +127,31 @@ class QuarterCarModel : public RigModel {
     vb_ = run.has("v_b") ? run.col("v_b") : central_diff(run.col("x_b"), dt_);
     vw_ = run.has("v_w") ? run.col("v_w") : central_diff(xw_, dt_);
     outputs_ = {{"x_b", run.col("x_b")}, {"x_w", xw_}, {"u", run.col("u")}, {"x_r", xr_}};
-    if (run.has("f_t")) ft_ = run.col("f_t");
     if (run.has("p1") && run.has("p2")) {
       outputs_.push_back({"p1", run.col("p1")});
       outputs_.push_back({"p2", run.col("p2")});
+    }
+    act_outputs_ = outputs_.size() - 2;
+    seal_sum_ = p_.supply_pressure;  // without pressures: the symmetric valve's rest, p1 + p2 = Ps
+    if (act_outputs_ > 2) {
+      const auto &p1 = outputs_[4].measured, &p2 = outputs_[5].measured;
+      double sum = 0.0;
+      for (std::size_t i = 0; i < p1.size(); ++i) sum += p1[i] + p2[i];
+      seal_sum_ = sum / static_cast<double>(std::max<std::size_t>(1, p1.size()));
+    }
+    // The tyre load cell, where the run has one, is an output of the
+    // suspension replay: a lift-off clips it at zero where the bilateral
+    // tyre pulls, which the positions show only faintly (a weak lift-off
+    // gains 0.1-0.4 pp on p1, and nothing on x_w).
+    if (run.has("f_t")) {
+      ft_ = run.col("f_t");
+      outputs_.push_back({"f_t", ft_});
+      // The tyre's damping force on the load cell takes the rod velocity
+      // over +-2 samples: the +-1 difference of a 20 um LVDT is 5.7 mm/s of
+      // noise, 22 N through the tyre's 3.9 kN s/m, more than the load cell's
+      // own; over +-2 it is half that, and a 10 Hz wheel hop loses 1.6 %.
+      vr_load_.assign(xr_.size(), 0.0);
+      for (std::size_t i = 2; i + 2 < xr_.size(); ++i) vr_load_[i] = (xr_[i + 2] - xr_[i - 2]) / (4.0 * dt_);
     }
   }
   RunFileRig rig() const override { return RunFileRig::kQuarterCar; }
@@ -168,9 +192,15 @@ class QuarterCarModel : public RigModel {
          "constant offsets on the x_b and x_w transducers"},
         {"tyre_liftoff", {P("unilateral", "1", 0.5, 0.0, 1.0, 1.0, 0.0, true)},
          "the tyre cannot pull: contact force F + unilateral softplus(-F) (smooth over 20 N)"},
+        // The level at the run's mean pressure sum and its slope, not the
+        // preload and the slope: over one run's narrow band of p1 + p2 the
+        // preload and the slope trade against each other, so neither was 3
+        // sigma from 0 beside bearing friction (2.1 pp on p1), though the
+        // level they make together is.
         {"actuator_seal_friction",
-         {P("F_pr", "N", 50.0, 0.0, 2000.0, 50.0, 0.0, true), P("f_c", "N/Pa", 0.0, 0.0, 1e-4, 2e-6, 0.0, true)},
-         "rod seal friction (F_pr + f_c (p1 + p2)) tanh(v_r / 0.02 m/s) on the actuator"},
+         {P("F_m", "N", 50.0, 0.0, 2000.0, 50.0, 0.0, true), P("f_c", "N/Pa", 0.0, 0.0, 1e-4, 2e-6, 0.0, true)},
+         "rod seal friction: Coulomb (F_m + f_c (p1 + p2 - " + fmt_bar(seal_sum_) +
+             " bar, the run's mean)) sign(v_r) on the actuator, stick-capable"},
         {"cross_port_leakage", {P("C_il", "m^3/(s Pa)", 2e-12, 0.0, 1e-9, 4e-12, 0.0, true)},
          "extra laminar cross-port leakage C_il (p1 - p2) beside the nominal one"},
         {"valve_deadband", {P("delta", "1", 0.01, 0.0, 0.3, 0.01, 0.0, true, {0.04})},
@@ -195,8 +225,9 @@ class QuarterCarModel : public RigModel {
   std::string replay() const override {
     return "two sub-models: the actuator by closed-loop replay (x_ref through the rig's PI controller, servovalve "
            "and actuator, 5 RK4 sub-steps per period, tyre load over the measured wheel motion: outputs u, x_r, p1, "
-           "p2) and the suspension by open-loop replay (measured x_r drives wheel and body, 8 sub-steps, implicit "
-           "stick-capable bearing friction: outputs x_b, x_w); " + controller_source_;
+           "p2; the seal friction applied implicitly after each sub-step) and the suspension by open-loop replay "
+           "(measured x_r drives wheel and body, 8 sub-steps, implicit stick-capable bearing friction: outputs x_b, "
+           "x_w and, where recorded, the tyre load f_t); " + controller_source_;
   }
   // The two sub-models share only `unilateral`; a fit that moves one
   // sub-model's parameters (a column of the central differences, say) takes
@@ -212,18 +243,23 @@ class QuarterCarModel : public RigModel {
     ks.push_back(static_cast<double>(samples));  // a prefix is not the whole replay
     ka.push_back(static_cast<double>(samples));
     std::vector<std::vector<double>> part;
+    const std::size_t ft = 2 + act_outputs_;  // f_t's index, if recorded
+    const bool has_ft = !ft_.empty();
     if (susp_cache_.find(ks, part)) {
       y[0] = std::move(part[0]);
       y[1] = std::move(part[1]);
+      if (has_ft) y[ft] = std::move(part[2]);
     } else {
-      simulate_suspension(th, y[0], y[1], samples);
-      susp_cache_.put(ks, {y[0], y[1]});
+      std::vector<double> unused;
+      simulate_suspension(th, y[0], y[1], has_ft ? y[ft] : unused, samples);
+      if (has_ft) susp_cache_.put(ks, {y[0], y[1], y[ft]});
+      else susp_cache_.put(ks, {y[0], y[1]});
     }
     if (act_cache_.find(ka, part)) {
-      for (std::size_t o = 2; o < y.size(); ++o) y[o] = std::move(part[o - 2]);
+      for (std::size_t o = 0; o < act_outputs_; ++o) y[2 + o] = std::move(part[o]);
     } else {
       simulate_actuator(th, y, samples);
-      act_cache_.put(ka, std::vector<std::vector<double>>(y.begin() + 2, y.end()));
+      act_cache_.put(ka, std::vector<std::vector<double>>(y.begin() + 2, y.begin() + 2 + static_cast<std::ptrdiff_t>(act_outputs_)));
     }
   }
   Indicator indicator(const std::string& cause) const override {
@@ -259,8 +295,11 @@ class QuarterCarModel : public RigModel {
   }
 
  private:
+  // yf: the tyre load (static part included), filled when it has the
+  // record's length.
   void simulate_suspension(const std::vector<double>& th, std::vector<double>& yb, std::vector<double>& yw,
-                           std::size_t samples) const {
+                           std::vector<double>& yf, std::size_t samples) const {
+    const bool load = yf.size() == t_.size();
     const double ks = th[kKs], bd = th[kBd], Fc = th[kFc], dFs = th[kDFs], D = th[kD], mu = th[kMu], dc = th[kDc],
                  tau = th[kTau], b_b = th[kBb], b_w = th[kBw], uni = th[kUni];
     const std::size_t n = t_.size();
@@ -276,6 +315,7 @@ class QuarterCarModel : public RigModel {
       yw[i] = xw + b_w;
       const double xr0 = xr_[i], xr1 = i + 1 < n ? xr_[i + 1] : xr_[i];
       const double vr = (xr1 - xr0) / dt_;
+      if (load) yf[i] = tyre_contact(f0 + kt * (xr0 - xw) + bt * (vr_load_[i] - vw), uni);
       for (int s = 0; s < sub; ++s) {
         const double xr = xr0 + (xr1 - xr0) * (s + 0.5) / sub;
         const double vrel = vw - vb;
@@ -295,6 +335,7 @@ class QuarterCarModel : public RigModel {
       }
       if (!std::isfinite(xb) || !std::isfinite(xw)) {
         for (std::size_t j = i; j < n; ++j) yb[j] = yw[j] = 1e3;
+        if (load) std::fill(yf.begin() + static_cast<std::ptrdiff_t>(i), yf.end(), 1e9);
         return;
       }
     }
@@ -326,18 +367,16 @@ class QuarterCarModel : public RigModel {
     if (a.p2 <= p.cavitation_pressure && d.p2 < 0.0) d.p2 = 0.0;
     const double f0 = (th[kMb] + th[kMw]) * p.gravity;
     const double f_tyre = tyre_contact(f0 + th[kKt] * (a.xr - xw) + th[kBt] * (a.vr - vw), th[kUni]);
-    // tanh (through expm1) was half the replay's time when profiled: it is
-    // computed only when the seal friction is in.
-    const double seal_level = th[kSealPr] + th[kSealPc] * std::max(0.0, a.p1 + a.p2);
-    const double seal = seal_level != 0.0 ? seal_level * std::tanh(a.vr / 0.02) : 0.0;
+    // The seal's friction is not here: simulate_actuator applies it after
+    // each sub-step, implicitly (it may be a sharp step).
     d.xr = a.vr;
-    d.vr = (a.p1 * a1 - a.p2 * a2 - th[kBvr] * a.vr - f_tyre - p.mass_rod * p.gravity - seal) / p.mass_rod;
+    d.vr = (a.p1 * a1 - a.p2 * a2 - th[kBvr] * a.vr - f_tyre - p.mass_rod * p.gravity) / p.mass_rod;
   }
 
   void simulate_actuator(const std::vector<double>& th, std::vector<std::vector<double>>& y,
                          std::size_t samples) const {
     const std::size_t n = t_.size();
-    const bool pressures = outputs_.size() > 4;
+    const bool pressures = act_outputs_ > 2;
     PiController pi(pi_);
     pi.reset();
     const QuarterCarState rest = QuarterCarPlant::rest_state(p_);
@@ -354,6 +393,7 @@ class QuarterCarModel : public RigModel {
     // cost twice as much for 0.004 pp.
     const int sub = 5;
     const double h = dt_ / sub;
+    const bool seal_in = th[kSealFm] != 0.0 || th[kSealPc] != 0.0;
     Sample s;
     Command c;
     ControllerTerms terms;
@@ -389,21 +429,34 @@ class QuarterCarModel : public RigModel {
         a.vr += h / 6.0 * (k1.vr + 2 * k2.vr + 2 * k3.vr + k4.vr);
         a.p1 = std::max(a.p1, p_.cavitation_pressure);
         a.p2 = std::max(a.p2, p_.cavitation_pressure);
+        // The seal's Coulomb friction, split from the RK4 step and applied
+        // implicitly (Moreau), so the rod can stick: a seal's step is sharp
+        // (1-10 mm/s) against the 5 kg rod, a slope RK4 at 0.5 ms cannot
+        // take smoothly. The earlier tanh(v_r / 0.02 m/s) was what RK4
+        // could: it gained 0.98 pp against the 1 pp floor on the sweep's
+        // strong Stribeck-form seal (1.16 pp now) and 1.58 on the Simscape
+        // form (1.92 now).
+        if (seal_in) {
+          const double level = std::max(0.0, th[kSealFm] + th[kSealPc] * (std::max(0.0, a.p1 + a.p2) - seal_sum_));
+          a.vr = implicit_velocity(p_.mass_rod, a.vr, 0.0, h, level, level, 0.0, 0.0);
+        }
       }
       if (!std::isfinite(a.xr) || !std::isfinite(a.p1) || !std::isfinite(a.p2)) {
         for (std::size_t j = i; j < n; ++j)
-          for (std::size_t o = 2; o < y.size(); ++o) y[o][j] = 1e9;
+          for (std::size_t o = 2; o < 2 + act_outputs_; ++o) y[o][j] = 1e9;
         return;
       }
     }
   }
 
-  std::vector<double> t_, xref_, xr_, vr_, xw_, vb_, vw_, ft_;
+  std::vector<double> t_, xref_, xr_, vr_, xw_, vb_, vw_, ft_, vr_load_;
   double dt_;
   QuarterCarParams p_;
   PiConfig pi_;
   std::string controller_source_;
   std::vector<Output> outputs_;
+  std::size_t act_outputs_ = 2;  // u, x_r and, where recorded, p1 and p2
+  double seal_sum_ = 0.0;          // [Pa] the pressure sum the seal's level F_m is at
   ReplayCache susp_cache_, act_cache_;
 };
 
