@@ -138,6 +138,7 @@ int main(int argc, char** argv) {
   bench_cmd->add_option("--json", bench.json_path, "Write every result to this JSON file");
   bench_cmd->add_option("--config-dir", bench.config_dir, "Folder with quarter_car.yaml and pneumatic_rotary.yaml (default: config)")->check(CLI::ExistingDirectory);
   bench_cmd->add_option("--sweep-rig", bench.sweep_rig, "diagnosis_sweep: only this rig kind");
+  bench_cmd->add_option("--sweep-jobs", bench.sweep_jobs, "diagnosis_sweep: runs diagnosed at a time (default 2; 1: each its own wall time)")->check(CLI::Range(1, 8));
   bench_cmd->add_option("--section", bench.sections, "Run only this section; repeatable")->check(CLI::IsMember(rigctl::bench_section_names()));
 
   rigctl::DiagnoseCommandOptions diag;

@@ -193,6 +193,16 @@ TEST(BenchCommand, QuickRunWritesEverySection) {
   const Json& diagnosis = member(sections, "diagnosis");
   EXPECT_TRUE(diagnosis.contains("status"));
 
+  // Diagnosis sweep (quick: two quarter-car runs, two at a time): each
+  // run's diagnosis time is part of its whole time (making the run too).
+  const Json& sweep = member(member(sections, "diagnosis_sweep"), "quarter_car");
+  EXPECT_EQ(member(sweep, "jobs").number(), 2);
+  ASSERT_EQ(member(sweep, "runs").size(), 2u);
+  for (const Json& run : member(sweep, "runs").items()) {
+    EXPECT_GT(member(run, "diagnose_seconds").number(), 0.0);
+    EXPECT_LT(member(run, "diagnose_seconds").number(), member(run, "seconds").number());
+  }
+
   // Scaling: plant cost against sub-steps and tick time against actuators.
   const Json& scaling = member(sections, "scaling");
   expect_ran(scaling, "scaling");

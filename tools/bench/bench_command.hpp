@@ -20,6 +20,10 @@ struct BenchOptions {
   std::vector<std::string> sections;  // run only these (names as bench_section_names()); empty = all
   std::string command_line;           // as typed, for the record
   std::string sweep_rig;              // diagnosis_sweep: only this rig ("" = all three)
+  // diagnosis_sweep: runs made and diagnosed at a time. 2 fills the cores
+  // sooner; 1 gives each diagnosis the machine, so its wall time is the one
+  // a user at the rig waits (docs/diagnosis.md 7, the speed criterion).
+  int sweep_jobs = 2;
 };
 
 // Section names in the order they run.

@@ -138,6 +138,7 @@ Section diagnosis_sweep_section() {
               o.rig = rig;
               o.pairs = pairs.at(rig);
               o.config_path = ctx.options.config_dir + "/" + rig + ".yaml";
+              o.threads = ctx.options.sweep_jobs;
               if (ctx.quick()) {  // two runs: checks the path, not the accuracy
                 o.causes = {"sensor_offset"};
                 o.levels = {1.0};
@@ -167,6 +168,7 @@ Section diagnosis_sweep_section() {
               part["pairs_found"] = r.pairs_found;
               part["pairs_total"] = r.pairs_total;
               part["wall_s"] = r.wall_s;
+              part["jobs"] = r.jobs;
               part["confusion_markdown"] = md.str();
               Json cells = Json::array();
               for (const auto& c : r.cells) {
@@ -175,6 +177,7 @@ Section diagnosis_sweep_section() {
                 cell["level"] = c.level;
                 cell["named"] = c.named;
                 cell["seconds"] = c.seconds;
+                cell["diagnose_seconds"] = c.diagnose_seconds;
                 cell["gain_percent_points"] = c.gain;
                 Json named = Json::array();
                 for (const auto& x : c.all_named) named.push_back(x);

@@ -66,8 +66,10 @@ SweepResult run_sweep(const SweepOptions& o, const std::atomic<bool>& stop, std:
         i = next++;
       }
       const Job& j = jobs[i];
-      SweepCell cell{j.second.empty() ? j.truth : j.truth + "+" + j.second, level_name(j.level), "error", 0.0, 0.0, {},
-                     false};
+      SweepCell cell;
+      cell.truth = j.second.empty() ? j.truth : j.truth + "+" + j.second;
+      cell.level = level_name(j.level);
+      cell.named = "error";
       const auto start = std::chrono::steady_clock::now();
       try {
         MakeRunOptions mr;
@@ -80,9 +82,11 @@ SweepResult run_sweep(const SweepOptions& o, const std::atomic<bool>& stop, std:
         mr.out_csv = dir + "/run-" + std::to_string(i) + ".csv";
         std::ostringstream quiet;
         make_run(mr, quiet);
+        const auto d_start = std::chrono::steady_clock::now();
         const auto rf = read_run_file(mr.out_csv, run_file_columns(run_file_rig(rig)));
         const auto model = diag::make_rig_model(run_file_rig(rig), rf, {});
         const auto d = diag::diagnose(*model, {});
+        cell.diagnose_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - d_start).count();
         cell.named = d.cause;
         if (!d.causes.empty()) cell.gain = d.causes.front().gain_percent_points;
         for (const auto& c : d.causes) cell.all_named.push_back(c.cause);
@@ -101,12 +105,14 @@ SweepResult run_sweep(const SweepOptions& o, const std::atomic<bool>& stop, std:
       progress << "  [" << done << "/" << jobs.size() << "] " << cell.truth << " (" << cell.level << ", seed "
                << j.seed << ") -> " << (named.empty() ? cell.named : named)
                << (cell.unexplained ? " (unexplained)" : "") << (cell.named == cell.truth ? "" : "   <-- differs")
-               << "  " << std::fixed << std::setprecision(1) << cell.seconds << " s\n";
+               << "  " << std::fixed << std::setprecision(1) << cell.seconds << " s (diagnosis "
+               << cell.diagnose_seconds << " s)\n";
       progress.flush();
     }
   };
   std::vector<std::thread> pool;
-  for (int k = 0; k < std::max(1, o.threads); ++k) pool.emplace_back(worker);
+  r.jobs = std::max(1, o.threads);
+  for (int k = 0; k < r.jobs; ++k) pool.emplace_back(worker);
   for (auto& t : pool) t.join();
   if (o.scratch_dir.empty()) std::filesystem::remove_all(dir);
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -164,6 +170,14 @@ void write_confusion_markdown(const SweepResult& r, std::ostream& out) {
       }
   }
   out << " " << std::setprecision(0) << r.wall_s << " s wall.\n";
+  std::vector<double> t;
+  for (const auto& c : r.cells) t.push_back(c.diagnose_seconds);
+  if (!t.empty()) {
+    std::sort(t.begin(), t.end());
+    const double median = t.size() % 2 ? t[t.size() / 2] : 0.5 * (t[t.size() / 2 - 1] + t[t.size() / 2]);
+    out << "Diagnosis wall time per run: median " << std::setprecision(1) << median << " s, worst " << t.back()
+        << " s (" << r.jobs << " at a time).\n";
+  }
 }
 
 }  // namespace rigctl

@@ -30,7 +30,8 @@ struct SweepOptions {
 
 struct SweepCell {
   std::string truth, level, named;  // level: "weak", "strong" or "clean"; truth "a+b" for a pair
-  double seconds = 0.0;
+  double seconds = 0.0;           // making the run and diagnosing it
+  double diagnose_seconds = 0.0;  // diagnosing it (the model from the run file, then diagnose())
   double gain = 0.0;  // of the named cause (0 for none)
   std::vector<std::string> all_named;
   bool unexplained = false;
@@ -41,6 +42,7 @@ struct SweepResult {
   std::map<std::string, std::map<std::string, int>> confusion;  // truth -> named -> count
   std::vector<SweepCell> cells;
   int correct = 0, total = 0;       // single-effect and clean runs: top cause right
+  int jobs = 1;                     // runs made and diagnosed at a time
   int pairs_found = 0, pairs_total = 0;  // two-effect runs: both named
   double wall_s = 0.0;
 };
