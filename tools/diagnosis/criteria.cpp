@@ -117,9 +117,12 @@ bool explains_misfit(const CandidateEvidence& c) {
   return after <= (1.0 - kExplainedShare) * before;
 }
 
+double gain_floor(const CandidateEvidence& c, const DiagnoseOptions& o) {
+  return explains_misfit(c) ? o.explained_min_gain : o.min_gain;
+}
+
 std::string rejection(const CandidateEvidence& c, const DiagnoseOptions& o) {
-  const double floor = explains_misfit(c) ? o.explained_min_gain : o.min_gain;
-  const double need = std::max(floor, 2.0 * c.se);
+  const double need = std::max(gain_floor(c, o), 2.0 * c.se);
   if (!(c.gain >= need)) return "held-out gain " + fmt(c.gain) + " pp below " + fmt(need) + " pp";
   const bool obvious = c.gain >= o.strong_gain && c.gain >= o.strong_se * c.se;
   if (!c.significant && !obvious)

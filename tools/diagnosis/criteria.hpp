@@ -69,6 +69,10 @@ bool misfits_beyond_noise(double excess, double fit_percent);
 constexpr double kExplainedShare = 0.75;
 bool explains_misfit(const CandidateEvidence& c);
 
+// The held-out gain a candidate must reach: explained_min_gain where it
+// explains a misfit beyond the noise, else g_min.
+double gain_floor(const CandidateEvidence& c, const DiagnoseOptions& o);
+
 // Empty when the candidate passes, else why not. The held-out gain must
 // reach g_min and two standard errors; where the current model misfits
 // beyond the noise and the candidate explains that misfit (explains_misfit),

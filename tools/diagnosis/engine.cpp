@@ -33,7 +33,7 @@ struct Candidate {
   std::size_t signal = 0;
   double gain = 0.0, se = 0.0;
   double excess_before = 0.0, excess_after = 0.0;  // its signal's held-out rms / noise floor
-  bool explains_misfit = false;                    // criteria.hpp explains_misfit
+  double floor = 0.0;                              // the gain it must reach (criteria.hpp gain_floor)
   std::string reason;                              // empty: passes
 };
 
@@ -168,7 +168,7 @@ double gain_floor(const Workspace& w, const Scored& without, const Scored& with,
   ev.excess_before = held_out_excess(w, without, o);
   ev.excess_after = held_out_excess(w, with, o);
   ev.fit_before = without.fit[o];
-  return explains_misfit(ev) ? w.options.explained_min_gain : w.options.min_gain;
+  return gain_floor(ev, w.options);
 }
 
 bool strength_significant(const Workspace& w, std::size_t e, const Scored& s) {
@@ -216,7 +216,7 @@ Candidate refit_one(const Workspace& w, const Candidate& screened, const Scored&
   r.reason = rejection(ev, w.options);
   r.excess_before = ev.excess_before;
   r.excess_after = ev.excess_after;
-  r.explains_misfit = explains_misfit(ev);
+  r.floor = gain_floor(ev, w.options);
   return r;
 }
 
@@ -243,7 +243,7 @@ std::vector<Candidate> refit_best(const Workspace& w, std::vector<Candidate> scr
       sc.signal = w.outs()[r.signal].name;
       sc.reason = r.reason.empty() ? "passes" : r.reason;
       std::string misfit;
-      if (r.explains_misfit)
+      if (r.floor < w.options.min_gain)
         misfit = "; residual " + fmt(r.excess_before, 3) + " -> " + fmt(r.excess_after, 3) + " x its noise floor";
       w.say("  " + sc.cause + ": gain " + fmt(r.gain, 3) + " pp on " + sc.signal + " (" + sc.reason + misfit + ")");
     }
@@ -278,13 +278,12 @@ double confidence(const Workspace& w, const Candidate& win, const std::vector<Ca
     sims.push_back(&refits[r].s.y[win.signal]);
   }
   const auto fits = bootstrap_fits(w.outs()[win.signal].measured, sims, w.val_begin, w.n, 400, 12345);
-  const double floor = win.explains_misfit ? w.options.explained_min_gain : w.options.min_gain;
   int wins = 0;
   for (const auto& row : fits) {
     std::size_t best = 1;
     for (std::size_t s = 2; s < row.size(); ++s)
       if (row[s] > row[best]) best = s;
-    if (best == wi && row[best] - row[0] >= floor) ++wins;
+    if (best == wi && row[best] - row[0] >= win.floor) ++wins;
   }
   return static_cast<double>(wins) / static_cast<double>(fits.size());
 }
@@ -300,8 +299,7 @@ CauseResult describe(const Workspace& w, const Candidate& win, const std::vector
   cr.extended_fit_percent = win.s.fit[win.signal];
   cr.gain_percent_points = win.gain;
   for (const auto& r : refits)
-    if (&r != &win && r.gain >= (r.explains_misfit ? w.options.explained_min_gain : w.options.min_gain) &&
-        about_equal(r.gain, win.gain, w.options))
+    if (&r != &win && r.gain >= r.floor && about_equal(r.gain, win.gain, w.options))
       cr.ambiguous_with.push_back(w.effects[r.effect].cause);
   for (std::size_t j = 0; j < eff.params.size(); ++j) {
     const std::size_t i = w.offset[win.effect] + j;
