@@ -112,6 +112,50 @@ class WornLagModel : public LagModel {
   std::vector<double> u_;
 };
 
+// Two sub-models in one: output "b" (first) is a lag the model gets badly
+// wrong in a way nobody named (a slow 0.2 Hz swell of 150 noise sigmas), output
+// "a" the lag of LagModel with a small offset on its transducer. The offset
+// candidate acts on "a" only. `judged_on_own_outputs` says so through
+// RigModel::acts_on; without it the offset's parsimony is judged against
+// b's large, slowly coloured misfit too (the quarter car's seal friction
+// beside a body still misfit after bearing friction).
+class TwoSubModels : public RigModel {
+ public:
+  TwoSubModels(double offset_a, bool judged_on_own_outputs) : u_(input()), own_(judged_on_own_outputs) {
+    for (std::size_t i = 0; i < kN; ++i) t_.push_back(static_cast<double>(i) * kDt);
+    auto a = simulate_lag(u_, kGain, kTau, offset_a, 0.0), b = simulate_lag(u_, kGain, 2.0 * kTau, 0.0, 0.0);
+    std::mt19937_64 rng(9);
+    std::normal_distribution<double> noise(0.0, kNoise);
+    for (std::size_t i = 0; i < kN; ++i) {
+      a[i] += noise(rng);
+      b[i] += noise(rng) + 150.0 * kNoise * std::sin(2.0 * std::numbers::pi * 0.2 * t_[i]);
+    }
+    outputs_ = {{"b", b}, {"a", a}};
+  }
+  RunFileRig rig() const override { return RunFileRig::kDamper; }
+  const std::vector<Output>& outputs() const override { return outputs_; }
+  const std::vector<double>& time() const override { return t_; }
+  std::vector<ParamSpec> baseline() const override {
+    return {Prior("gain", "1", kGain, 0.05), Prior("tau", "s", kTau, 0.05), Prior("tau_b", "s", 2.0 * kTau, 0.05)};
+  }
+  std::vector<EffectSpec> effects() const override {
+    return {{"offset_a", {P("a", "1", 0.0, -1.0, 1.0, 0.01, 0.0, true)}, "an offset on a"}};
+  }
+  std::vector<std::size_t> acts_on(const std::string&) const override {
+    return own_ ? std::vector<std::size_t>{1} : std::vector<std::size_t>{};
+  }
+  void simulate(const std::vector<double>& th, std::vector<std::vector<double>>& y) const override {
+    y = {simulate_lag(u_, th[0], th[2], 0.0, 0.0), simulate_lag(u_, th[0], th[1], th[3], 0.0)};
+  }
+  std::string replay() const override { return "two synthetic lags"; }
+  Indicator indicator(const std::string&) const override { return {}; }
+
+ private:
+  std::vector<double> u_, t_;
+  bool own_;
+  std::vector<Output> outputs_;
+};
+
 Diagnosis run(const Truth& truth) {
   LagModel m(truth);
   return diagnose(m, {});
@@ -171,6 +215,22 @@ TEST(DiagnoseVerdicts, ASmallEffectThatIsTheWholeMisfitIsNamed) {
   const auto strict = diagnose(m, full_floor);
   EXPECT_EQ(strict.cause, "none");
   EXPECT_TRUE(strict.unexplained);
+}
+
+// The offset gains on "a"; its parsimony is judged on "a", not against b's
+// misfit, which it cannot change.
+TEST(DiagnoseVerdicts, AnEffectOfOneSubModelIsJudgedOnItsOwnOutputs) {
+  const double offset = 0.07;  // 35 noise sigmas on a: a gain that stands on its own
+  const auto own = diagnose(TwoSubModels(offset, true), {});
+  ASSERT_EQ(own.cause, "offset_a");
+  EXPECT_EQ(own.causes.front().signal, "a");
+  EXPECT_NEAR(own.causes.front().parameters[0].value, offset, 0.003);
+  // The same data with the parsimony judged on every output: b's slow
+  // misfit sets N_eff and dwarfs the offset's share of the SSE.
+  const auto all = diagnose(TwoSubModels(offset, false), {});
+  EXPECT_EQ(all.cause, "none");
+  ASSERT_FALSE(all.screened.empty());
+  EXPECT_NE(all.screened.front().reason.find("BIC"), std::string::npos) << all.screened.front().reason;
 }
 
 TEST(DiagnoseVerdicts, AMisfitNoCandidateExplainsIsUnexplainedWithItsBand) {

@@ -209,9 +209,16 @@ Candidate refit_one(const Workspace& w, const Candidate& screened, const Scored&
   const auto fits = bootstrap_fits(w.outs()[sig].measured, {&current.y[sig], &r.s.y[sig]}, w.val_begin, w.n, 200,
                                    777, 10, activity_strata(current.y[sig], r.s.y[sig], w.val_begin, w.n));
   r.se = gain_standard_error(fits, 1, 0);
+  // Parsimony on the outputs the candidate acts on (RigModel::acts_on): a
+  // sub-model's effect is not judged against the other sub-model's misfit
+  // (a seal friction's 1.5 pp on p1 was lost in the body's misfit after
+  // bearing friction, strongly coloured and many times larger).
+  const auto on = w.model.acts_on(cause);
+  const auto cur = w.on_outputs(current, on), cand = w.on_outputs(r.s, on);
+  const double n_eff = on.empty() ? neff : cur.n_eff;
   CandidateEvidence ev{r.gain, r.se, strength_significant(w, r.effect, r.s),
-                       bic(r.s.est_sse, w.parameter_count(act), neff, w.n_est_values),
-                       bic(current.est_sse, w.parameter_count(active), neff, w.n_est_values),
+                       bic(cand.sse, w.parameter_count(act), n_eff, cand.values),
+                       bic(cur.sse, w.parameter_count(active), n_eff, cur.values),
                        held_out_excess(w, current, sig), held_out_excess(w, r.s, sig), current.fit[sig]};
   r.reason = rejection(ev, w.options);
   r.excess_before = ev.excess_before;

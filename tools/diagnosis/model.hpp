@@ -87,6 +87,10 @@ class RigModel {
   // `cause` acts on: the screening frees only those (a rig of sub-models
   // screens a sub-model's effect without replaying the others).
   virtual bool couples(std::size_t /*index*/, const std::string& /*cause*/) const { return true; }
+  // The outputs an effect of `cause` can change (a rig of sub-models: its
+  // sub-model's). The parsimony test (BIC) of its candidate is judged on
+  // them. Empty: every output.
+  virtual std::vector<std::size_t> acts_on(const std::string& /*cause*/) const { return {}; }
   // How the sub-model is replayed (goes into the JSON `validation` string).
   virtual std::string replay() const = 0;
   // Samples at the start that no model can match (state initialisation).

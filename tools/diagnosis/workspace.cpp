@@ -118,6 +118,22 @@ double Workspace::n_eff(const Scored& s) const {
   return std::max(10.0, static_cast<double>(n_est_values) * effective_fraction(r));
 }
 
+Workspace::OnOutputs Workspace::on_outputs(const Scored& s, const std::vector<std::size_t>& outputs) const {
+  if (outputs.empty()) return {s.est_sse, n_eff(s), n_est_values};
+  OnOutputs r;
+  std::vector<double> first;
+  for (std::size_t o : outputs)
+    for (std::size_t i = 0; i < n; ++i)
+      if (est_mask[i]) {
+        const double e = (s.y[o][i] - outs()[o].measured[i]) * weight[o];
+        r.sse += std::isfinite(e) ? e * e : 1e12;
+        ++r.values;
+        if (o == outputs.front()) first.push_back(e);
+      }
+  r.n_eff = std::max(10.0, static_cast<double>(r.values) * effective_fraction(first));
+  return r;
+}
+
 double Workspace::residual_variance(const Scored& s) const {
   return s.est_sse / std::max(1.0, n_eff(s));
 }

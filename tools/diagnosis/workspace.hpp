@@ -49,6 +49,13 @@ class Workspace {
   std::vector<double> residual(const Scored& s, std::size_t output) const;
   // Effective sample count of a model's estimation residual (docs/diagnosis.md 5).
   double n_eff(const Scored& s) const;
+  // The same on some outputs only (empty: all): their weighted estimation
+  // SSE, value count and N_eff (the colour of the first of them).
+  struct OnOutputs {
+    double sse = 0.0, n_eff = 0.0;
+    std::size_t values = 0;
+  };
+  OnOutputs on_outputs(const Scored& s, const std::vector<std::size_t>& outputs) const;
   // Residual variance per effective sample: the priors' weight.
   double residual_variance(const Scored& s) const;
   void say(const std::string& message) const;

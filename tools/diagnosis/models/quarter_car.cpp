@@ -222,6 +222,16 @@ class QuarterCarModel : public RigModel {
     if (cause == "tyre_liftoff" || cause == "sensor_offset") return true;
     return !suspension_param || shared;
   }
+  std::vector<std::size_t> acts_on(const std::string& cause) const override {
+    if (cause == "tyre_liftoff" || cause == "sensor_offset") return {};  // both sub-models
+    static const char* kSuspensionCauses[] = {"bearing_friction", "damper_asymmetry", "sensor_delay"};
+    const std::size_t ft = 2 + act_outputs_;
+    for (const char* c : kSuspensionCauses)
+      if (cause == c) return ft_.empty() ? std::vector<std::size_t>{0, 1} : std::vector<std::size_t>{0, 1, ft};
+    std::vector<std::size_t> act;
+    for (std::size_t o = 2; o < ft; ++o) act.push_back(o);
+    return act;
+  }
   std::string replay() const override {
     return "two sub-models: the actuator by closed-loop replay (x_ref through the rig's PI controller, servovalve "
            "and actuator, 5 RK4 sub-steps per period, tyre load over the measured wheel motion: outputs u, x_r, p1, "
