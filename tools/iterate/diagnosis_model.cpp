@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <functional>
 #include <map>
 #include <stdexcept>
@@ -41,6 +42,12 @@ const std::map<std::string, Setter>& quarter_car_setters() {
       {"mu", [](QuarterCarParams& p, double v) { p.bearing_friction.normal_coefficient = v; }},
       {"delta", [](QuarterCarParams& p, double v) { p.hidden.valve_overlap = v; }},
       {"F_pr", [](QuarterCarParams& p, double v) { p.hidden.seal_preload = v; }},
+      // Entrained air as the candidate fits it: the mixture law with its
+      // bubble index (tools/diagnosis/models/quarter_car.cpp kBubbleIndex).
+      {"alpha", [](QuarterCarParams& p, double v) {
+         p.hidden.air_fraction = v;
+         p.hidden.air_polytropic_index = 1.2;
+       }},
       {"f_c", [](QuarterCarParams& p, double v) { p.hidden.seal_pressure_coefficient = v; }},
   };
   return s;
@@ -67,7 +74,8 @@ DiagnosisModel diagnosis_model(const RigConfig& nominal, const std::string& path
   }
   DiagnosisModel m{nominal, {}, {}};
   const auto& setters = quarter_car_setters();
-  double beta_ratio = 1.0;
+  double beta_ratio = 1.0;     // entrained air as a constant ratio (diagnoses before the mixture law)
+  double seal_level = -1.0;    // F_m: the seal's Coulomb level at the run's mean pressure sum
   for (const auto& kv : root["final_parameters"]) {
     const std::string name = kv.first.as<std::string>();
     if (kv.second.IsNull()) {  // undetermined by the run: the config's value stays
@@ -78,6 +86,9 @@ DiagnosisModel diagnosis_model(const RigConfig& nominal, const std::string& path
     if (name == "beta_ratio") {
       beta_ratio = value;
       m.applied.push_back(name);
+    } else if (name == "F_m") {
+      seal_level = value;
+      m.applied.push_back(name);
     } else if (const auto it = setters.find(name); it != setters.end()) {
       it->second(m.config.quarter_car, value);
       m.applied.push_back(name);
@@ -86,6 +97,13 @@ DiagnosisModel diagnosis_model(const RigConfig& nominal, const std::string& path
     }
   }
   m.config.quarter_car.bulk_modulus *= beta_ratio;
+  // The plant's seal law has a preload and a pressure term; the fitted level
+  // is at the run's mean p1 + p2, which the JSON does not carry: taken at
+  // the supply pressure, the sum at rest of a symmetric valve (a run's mean
+  // is within a few per cent of it).
+  auto& q = m.config.quarter_car;
+  if (seal_level >= 0.0)
+    q.hidden.seal_preload = std::max(0.0, seal_level - q.hidden.seal_pressure_coefficient * q.supply_pressure);
   return m;
 }
 

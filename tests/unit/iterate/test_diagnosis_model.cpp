@@ -36,6 +36,20 @@ TEST(DiagnosisModel, FinalParametersGoIntoThePlantUndeterminedOnesStay) {
   EXPECT_EQ(m.ignored, (std::vector<std::string>{"Mw", "tau"}));  // tau: a sensor's delay, not the plant's
 }
 
+// The candidates' own parameters: entrained air as the mixture law's air
+// fraction (with the candidate's bubble index), the seal's level at the
+// run's mean pressure sum taken at the supply pressure.
+TEST(DiagnosisModel, AirFractionAndSealLevelGoIntoThePlant) {
+  const auto m = diagnosis_model(quarter_car(), write("a.json", R"({"rig": "quarter_car", "cause": "entrained_air",
+      "final_parameters": {"alpha": 0.05, "F_m": 300.0, "f_c": 5.0e-6, "Ps": 2.0e7}})"));
+  const QuarterCarParams& p = m.config.quarter_car;
+  EXPECT_DOUBLE_EQ(p.hidden.air_fraction, 0.05);
+  EXPECT_DOUBLE_EQ(p.hidden.air_polytropic_index, 1.2);
+  EXPECT_DOUBLE_EQ(p.hidden.seal_pressure_coefficient, 5.0e-6);
+  EXPECT_NEAR(p.hidden.seal_preload, 300.0 - 5.0e-6 * 2.0e7, 1e-9);
+  EXPECT_TRUE(m.ignored.empty());
+}
+
 TEST(DiagnosisModel, TheShippedDiagnosisMapsOntoTheQuarterCar) {
   const auto m = diagnosis_model(quarter_car(), std::string(RIGCTL_TEST_DATA) + "/quarter_car_worn_seal_diagnosis.json");
   EXPECT_GE(m.applied.size(), 8u);
