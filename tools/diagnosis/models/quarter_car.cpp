@@ -54,6 +54,12 @@ double tyre_contact(double f_total, double uni) {
   return uni > 0.0 ? f_total + uni * softplus(-f_total, 20.0) : f_total;
 }
 
+// The causes of the suspension sub-model alone (tyre lift-off and the
+// sensor offset act in both; the rest are the actuator's).
+bool suspension_cause(const std::string& cause) {
+  return cause == "bearing_friction" || cause == "damper_asymmetry" || cause == "sensor_delay";
+}
+
 // Parameter indices (baseline, then effects in effects() order).
 enum : std::size_t {
   kKs, kBd, kMb, kMw, kKt, kBt,  // baseline: suspension and tyre
@@ -66,13 +72,13 @@ enum : std::size_t {
   kSealFm, kSealPc,              // actuator_seal_friction
   kLeak,                         // cross_port_leakage
   kDead,                         // valve_deadband
-  kBeta,                         // entrained_air
+  kAirFraction,                  // entrained_air
   kParamCount
 };
 
 constexpr std::size_t kSuspensionParams[] = {kKs, kBd, kMb, kMw, kKt, kBt, kFc, kDFs, kD, kMu, kDc, kTau, kBb, kBw, kUni};
 constexpr std::size_t kActuatorParams[] = {kMb,  kMw,  kKt,  kBt,    kKv,    kTauR, kBetaNom, kRl, kPs,  kA1,
-                                           kA2,  kBvr, kVd,  kUni,   kSealFm, kSealPc, kLeak, kDead, kBeta, kBw};
+                                           kA2,  kBvr, kVd,  kUni,   kSealFm, kSealPc, kLeak, kDead, kAirFraction, kBw};
 
 template <std::size_t N>
 std::vector<double> key(const std::vector<double>& th, const std::size_t (&idx)[N]) {
@@ -223,20 +229,19 @@ class QuarterCarModel : public RigModel {
   // the sensor offset both (an offset on x_w is also in the actuator's
   // wheel input, so the actuator's calibration may have bent to it).
   bool couples(std::size_t index, const std::string& cause) const override {
-    static const char* kSuspensionCauses[] = {"bearing_friction", "damper_asymmetry", "sensor_delay"};
     const bool suspension_param = index <= kBt;
     const bool shared = index >= kMb && index <= kBt;
-    for (const char* c : kSuspensionCauses)
-      if (cause == c) return suspension_param;
+    if (suspension_cause(cause)) return suspension_param;
     if (cause == "tyre_liftoff" || cause == "sensor_offset") return true;
     return !suspension_param || shared;
   }
   std::vector<std::size_t> acts_on(const std::string& cause) const override {
     if (cause == "tyre_liftoff" || cause == "sensor_offset") return {};  // both sub-models
-    static const char* kSuspensionCauses[] = {"bearing_friction", "damper_asymmetry", "sensor_delay"};
     const std::size_t ft = 2 + act_outputs_;
-    for (const char* c : kSuspensionCauses)
-      if (cause == c) return ft_.empty() ? std::vector<std::size_t>{0, 1} : std::vector<std::size_t>{0, 1, ft};
+    if (suspension_cause(cause)) {
+      if (ft_.empty()) return {0, 1};
+      return {0, 1, ft};
+    }
     std::vector<std::size_t> act;
     for (std::size_t o = 2; o < ft; ++o) act.push_back(o);
     return act;
@@ -278,7 +283,8 @@ class QuarterCarModel : public RigModel {
       for (std::size_t o = 0; o < act_outputs_; ++o) y[2 + o] = std::move(part[o]);
     } else {
       simulate_actuator(th, y, samples);
-      act_cache_.put(ka, std::vector<std::vector<double>>(y.begin() + 2, y.begin() + 2 + static_cast<std::ptrdiff_t>(act_outputs_)));
+      const auto first = y.begin() + 2;
+      act_cache_.put(ka, std::vector<std::vector<double>>(first, first + static_cast<std::ptrdiff_t>(act_outputs_)));
     }
   }
   Indicator indicator(const std::string& cause) const override {
@@ -378,7 +384,7 @@ class QuarterCarModel : public RigModel {
     const double q_leak = (p.leakage ? (a.p1 - a.p2) / th[kRl] : 0.0) + th[kLeak] * (a.p1 - a.p2);
     // Free air: a bulk modulus that falls with the chamber's pressure
     // (kBubbleIndex: bubbles between isothermal and adiabatic).
-    const double alpha = th[kBeta], beta_oil = th[kBetaNom];
+    const double alpha = th[kAirFraction], beta_oil = th[kBetaNom];
     const double beta1 = alpha > 0.0 ? mixture_bulk_modulus(beta_oil, alpha, kBubbleIndex, a.p1) : beta_oil;
     const double beta2 = alpha > 0.0 ? mixture_bulk_modulus(beta_oil, alpha, kBubbleIndex, a.p2) : beta_oil;
     const double a1 = th[kA1], a2 = th[kA2];
