@@ -233,6 +233,26 @@ TEST(DiagnoseVerdicts, AnEffectOfOneSubModelIsJudgedOnItsOwnOutputs) {
   EXPECT_NE(all.screened.front().reason.find("BIC"), std::string::npos) << all.screened.front().reason;
 }
 
+// A large offset nobody has modelled yet weighs the priors heavily (the
+// residual variance is 60 000 x the noise's), so the calibration moves the
+// lag's gain only part of the way from nominal. Once the offset is accepted,
+// the rig's +4 % gain and -4 % time constant must be calibrated as such
+// (the engine's recalibration), not left pinned at nominal for a next
+// candidate to soak up.
+TEST(DiagnoseVerdicts, AcceptingALargeEffectFreesTheCalibrationItHeldBack) {
+  Truth t;
+  t.offset = 0.5;  // 250 noise sigmas
+  const auto d = run(t);
+  ASSERT_FALSE(d.causes.empty());
+  EXPECT_TRUE(d.causes.front().cause == "offset_a" || d.causes.front().cause == "offset_b") << d.causes.front().cause;
+  EXPECT_LT(d.calibration[0].value, kGain * 1.03) << "the unmodelled offset holds the calibration back";
+  ASSERT_GE(d.final_parameters.size(), 2u);
+  EXPECT_EQ(d.final_parameters[0].name, "gain");
+  EXPECT_NEAR(d.final_parameters[0].value, kGain * 1.04, kGain * 0.005);
+  EXPECT_NEAR(d.final_parameters[1].value, kTau * 0.96, kTau * 0.01);
+  EXPECT_EQ(d.causes.size(), 1u) << "a second cause took up what the calibration left";
+}
+
 TEST(DiagnoseVerdicts, AMisfitNoCandidateExplainsIsUnexplainedWithItsBand) {
   Truth t;
   t.hum = 0.04;  // 20 noise sigmas at 7 Hz, which no candidate can make
