@@ -254,6 +254,9 @@ TEST(HiddenEffectsQuarterCar, StrongStribeckSealFrictionIsNamedAndSized) {
   const auto* c = expect_named("seal_friction_strong_stribeck", "actuator_seal_friction");
   if (!c) return;
   const Outcome& o = outcome("seal_friction_strong_stribeck");
+  // F_m is the level at the run's mean pressure sum, which the JSON's
+  // model_constants carry for `rigctl iterate`.
+  EXPECT_NEAR(o.diagnosis.model_constants.at("P_m"), o.pressure_sum_mean, 1e-6 * o.pressure_sum_mean);
   // The Coulomb level at the run's mean pressure sum (F_m). The truth's
   // Stribeck peak (1.3 x at rest, decaying over 20 mm/s) and its viscous
   // 300 N s/m lift the candidate's single level: 30 %.

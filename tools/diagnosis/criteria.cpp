@@ -91,8 +91,8 @@ std::vector<int> activity_strata(const std::vector<double>& a, const std::vector
   const double top = *std::max_element(ms.begin(), ms.end());
   if (!(top > 0.0)) return {};
   std::vector<int> s(blocks);
-  std::size_t active = 0;
-  for (std::size_t k = 0; k < blocks; ++k) active += static_cast<std::size_t>(s[k] = ms[k] >= kActiveShare * top ? 1 : 0);
+  for (std::size_t k = 0; k < blocks; ++k) s[k] = ms[k] >= kActiveShare * top ? 1 : 0;
+  const auto active = static_cast<std::size_t>(std::count(s.begin(), s.end(), 1));
   if (active < 2 || active == blocks) return {};
   return s;
 }

@@ -173,25 +173,19 @@ std::vector<Candidate> screen(const Workspace& w, const Scored& current, const s
 }
 
 // Held-out residual rms of output o over the record's noise floor on it.
-double held_out_excess(const Workspace& w, const Scored& s, std::size_t o, double* rms_out = nullptr) {
-  const auto e = w.residual(s, o);
-  double ss = 0.0;
-  for (std::size_t i = w.val_begin; i < w.n; ++i) ss += e[i] * e[i];
-  const double rms = std::sqrt(ss / static_cast<double>(std::max<std::size_t>(1, w.n - w.val_begin)));
-  if (rms_out) *rms_out = rms;
-  const double noise = noise_floor(w.outs()[o].measured);
-  return noise > 0.0 ? rms / noise : 0.0;
+double held_out_excess(const Workspace& w, const Scored& s, std::size_t o) {
+  return w.noise[o] > 0.0 ? w.held_out_rms(s, o) / w.noise[o] : 0.0;
 }
 
-// The gain a model `with` an effect must show over one `without` it on
-// output o: g_min, or explained_min_gain where it explains a misfit beyond
-// the noise (criteria.hpp).
-double gain_floor(const Workspace& w, const Scored& without, const Scored& with, std::size_t o) {
+// What the gates need of output o beyond the gain: the misfit of the model
+// `without` an effect and of the one `with` it (criteria.hpp gain_floor).
+CandidateEvidence misfit_evidence(const Workspace& w, const Scored& without, const Scored& with, std::size_t o) {
   CandidateEvidence ev;
+  ev.gain = with.fit[o] - without.fit[o];
   ev.excess_before = held_out_excess(w, without, o);
   ev.excess_after = held_out_excess(w, with, o);
   ev.fit_before = without.fit[o];
-  return gain_floor(ev, w.options);
+  return ev;
 }
 
 bool strength_significant(const Workspace& w, std::size_t e, const Scored& s) {
@@ -221,17 +215,19 @@ Candidate refit_one(const Workspace& w, const Candidate& screened, const Scored&
   // Its signal: the largest gain among the outputs where it reaches its
   // floor (a delay may gain most on dp but explain the misfit of theta),
   // else the largest gain.
-  r.gain = -1e9;
+  CandidateEvidence ev;
+  ev.gain = -1e9;
   bool reaches = false;
   for (std::size_t o = 0; o < w.outs().size(); ++o) {
-    const double g = r.s.fit[o] - current.fit[o];
-    const bool here = g >= gain_floor(w, current, r.s, o);
-    if ((here && !reaches) || (here == reaches && g > r.gain)) r.gain = g, r.signal = o, reaches = here;
+    const CandidateEvidence here = misfit_evidence(w, current, r.s, o);
+    const bool passes = here.gain >= gain_floor(here, w.options);
+    if ((passes && !reaches) || (passes == reaches && here.gain > ev.gain)) ev = here, r.signal = o, reaches = passes;
   }
   const auto& sig = r.signal;
+  r.gain = ev.gain;
   const auto fits = bootstrap_fits(w.outs()[sig].measured, {&current.y[sig], &r.s.y[sig]}, w.val_begin, w.n, 200,
                                    777, 10, activity_strata(current.y[sig], r.s.y[sig], w.val_begin, w.n));
-  r.se = gain_standard_error(fits, 1, 0);
+  r.se = ev.se = gain_standard_error(fits, 1, 0);
   // Parsimony on the outputs the candidate acts on (RigModel::acts_on): a
   // sub-model's effect is not judged against the other sub-model's misfit
   // (a seal friction's 1.5 pp on p1 was lost in the body's misfit after
@@ -239,10 +235,9 @@ Candidate refit_one(const Workspace& w, const Candidate& screened, const Scored&
   const auto on = w.model.acts_on(cause);
   const auto cur = w.on_outputs(current, on), cand = w.on_outputs(r.s, on);
   const double n_eff = on.empty() ? neff : cur.n_eff;
-  CandidateEvidence ev{r.gain, r.se, strength_significant(w, r.effect, r.s),
-                       bic(cand.sse, w.parameter_count(act), n_eff, cand.values),
-                       bic(cur.sse, w.parameter_count(active), n_eff, cur.values),
-                       held_out_excess(w, current, sig), held_out_excess(w, r.s, sig), current.fit[sig]};
+  ev.significant = strength_significant(w, r.effect, r.s);
+  ev.bic_new = bic(cand.sse, w.parameter_count(act), n_eff, cand.values);
+  ev.bic_current = bic(cur.sse, w.parameter_count(active), n_eff, cur.values);
   r.reason = rejection(ev, w.options);
   r.excess_before = ev.excess_before;
   r.excess_after = ev.excess_after;
@@ -388,7 +383,8 @@ void backward_check(const Workspace& w, std::vector<std::size_t>& active, Scored
     bool earns = false;
     for (std::size_t o = 0; o < w.outs().size(); ++o) {
       best = std::max(best, current.fit[o] - without.fit[o]);
-      earns = earns || current.fit[o] - without.fit[o] >= gain_floor(w, without, current, o);
+      const CandidateEvidence ev = misfit_evidence(w, without, current, o);
+      earns = earns || ev.gain >= gain_floor(ev, w.options);
     }
     if (!earns) {
       w.say("  dropped " + eff.cause + " (only " + fmt(best, 3) + " pp given the others)");
@@ -410,13 +406,12 @@ void check_unexplained(const Workspace& w, const Scored& current, Diagnosis& d) 
   const double dt = w.n > 1 ? (w.model.time().back() - w.model.time().front()) / static_cast<double>(w.n - 1) : 1.0;
   double worst = 0.0;
   for (std::size_t o = 0; o < w.outs().size(); ++o) {
-    double rms = 0.0;
-    const double excess = held_out_excess(w, current, o, &rms);
+    const double excess = held_out_excess(w, current, o);
     if (misfits_beyond_noise(excess, current.fit[o]) && excess > worst) {
       worst = excess;
       const Band band = power_band(w.residual(current, o), dt, w.val_begin, w.n);
       d.unexplained = true;
-      d.unexplained_residual = {w.outs()[o].name, rms, noise_floor(w.outs()[o].measured), band.lo_hz, band.hi_hz,
+      d.unexplained_residual = {w.outs()[o].name, w.held_out_rms(current, o), w.noise[o], band.lo_hz, band.hi_hz,
                                 band.peak_hz};
     }
   }
@@ -428,6 +423,7 @@ void check_unexplained(const Workspace& w, const Scored& current, Diagnosis& d) 
 void finish(const Workspace& w, const std::vector<std::size_t>& active, const Scored& base, const Scored& current,
             Diagnosis& d) {
   d.cause = d.causes.empty() ? "none" : d.causes.front().cause;
+  d.model_constants = w.model.constants();
   const auto fr = w.free_for(active);
   for (std::size_t i = 0; i < w.specs.size(); ++i)
     if (fr[i])

@@ -73,6 +73,7 @@ struct Diagnosis {
   std::vector<ScreenedCandidate> screened;
   std::vector<ParamValue> baseline_parameters;
   std::vector<ParamValue> final_parameters;  // baseline + kept effects, refitted jointly
+  std::map<std::string, double> model_constants;  // RigModel::constants()
   std::vector<Calibrated> calibration;       // the baseline's calibration against its priors
   // The baseline misfits beyond the noise but no candidate earned a validated
   // gain: cause stays none, and the residual is described.

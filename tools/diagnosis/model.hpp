@@ -9,6 +9,7 @@
 // baseline with that effect's parameters freed (docs/diagnosis.md 1).
 #pragma once
 
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -91,6 +92,11 @@ class RigModel {
   // sub-model's). The parsimony test (BIC) of its candidate is judged on
   // them. Empty: every output.
   virtual std::vector<std::size_t> acts_on(const std::string& /*cause*/) const { return {}; }
+  // Fixed values the candidates' laws are written around, by name [SI]: a
+  // tool that maps the fitted parameters onto a plant needs them (the quarter
+  // car's seal level F_m is at the run's mean pressure sum P_m). JSON
+  // `model_constants`.
+  virtual std::map<std::string, double> constants() const { return {}; }
   // How the sub-model is replayed (goes into the JSON `validation` string).
   virtual std::string replay() const = 0;
   // Samples at the start that no model can match (state initialisation).

@@ -26,7 +26,8 @@ std::string fmt(double v, int prec = 4) {
 
 namespace {
 
-std::string json_fit_map(const std::map<std::string, double>& m) {
+// {name: number}
+std::string json_number_map(const std::map<std::string, double>& m) {
   std::string s = "{";
   bool first = true;
   for (const auto& [k, v] : m) {
@@ -88,8 +89,8 @@ void write_json(const Diagnosis& d, std::ostream& out) {
         << "}";
   }
   out << (d.causes.empty() ? "],\n" : "\n  ],\n");
-  out << "  \"baseline_fit_percent\": " << json_fit_map(d.baseline_fit_percent) << ",\n";
-  out << "  \"extended_fit_percent\": " << json_fit_map(d.extended_fit_percent) << ",\n";
+  out << "  \"baseline_fit_percent\": " << json_number_map(d.baseline_fit_percent) << ",\n";
+  out << "  \"extended_fit_percent\": " << json_number_map(d.extended_fit_percent) << ",\n";
   out << "  \"validation\": " << json_string(d.validation) << ",\n";
   out << "  \"unexplained\": " << (d.unexplained ? "true" : "false") << ",\n";
   if (d.unexplained) {
@@ -117,6 +118,7 @@ void write_json(const Diagnosis& d, std::ostream& out) {
   out << "  \"baseline_parameters\": " << json_values(d.baseline_parameters);
   out << ",\n  \"final_parameters\": " << json_values(d.final_parameters);
   out << ",\n  \"undetermined_parameters\": " << json_names_where(d.final_parameters, false);
+  out << ",\n  \"model_constants\": " << json_number_map(d.model_constants);
   out << ",\n  \"screened\": [";
   for (std::size_t j = 0; j < d.screened.size(); ++j) {
     const auto& s = d.screened[j];

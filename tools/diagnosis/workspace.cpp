@@ -6,6 +6,7 @@
 #include <mutex>
 
 #include "tools/diagnosis/criteria.hpp"
+#include "tools/diagnosis/evidence.hpp"
 #include "tools/diagnosis/fit.hpp"
 
 namespace rigctl::diag {
@@ -46,6 +47,7 @@ Workspace::Workspace(const RigModel& m, const DiagnoseOptions& o)
     for (double v : out.measured) ss += (v - mean) * (v - mean);
     const double sd = std::sqrt(ss / static_cast<double>(n));
     weight.push_back(sd > 0.0 ? 1.0 / sd : 1.0);
+    noise.push_back(noise_floor(out.measured));
   }
   n_est_values = (n_est > init ? n_est - init : 0) * outs().size();
 }
@@ -108,6 +110,15 @@ std::vector<double> Workspace::residual(const Scored& s, std::size_t o) const {
   std::vector<double> r(n);
   for (std::size_t i = 0; i < n; ++i) r[i] = outs()[o].measured[i] - s.y[o][i];
   return r;
+}
+
+double Workspace::held_out_rms(const Scored& s, std::size_t o) const {
+  double ss = 0.0;
+  for (std::size_t i = val_begin; i < n; ++i) {
+    const double e = outs()[o].measured[i] - s.y[o][i];
+    ss += e * e;
+  }
+  return std::sqrt(ss / static_cast<double>(std::max<std::size_t>(1, n - val_begin)));
 }
 
 double Workspace::n_eff(const Scored& s) const {

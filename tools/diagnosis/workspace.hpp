@@ -37,6 +37,7 @@ class Workspace {
   std::size_t n = 0, init = 0, n_est = 0, val_begin = 0;
   std::vector<unsigned char> est_mask;
   std::vector<double> weight;        // per output: 1 / std
+  std::vector<double> noise;         // per output: the record's noise floor (evidence.hpp noise_floor)
   std::size_t n_est_values = 0;      // estimation samples x outputs
   double prior_weight = 0.0;         // FitProblem::prior_weight
 
@@ -47,6 +48,7 @@ class Workspace {
   std::vector<bool> free_for(const std::vector<std::size_t>& active) const;  // baseline + these effects
   std::size_t parameter_count(const std::vector<std::size_t>& active) const;
   std::vector<double> residual(const Scored& s, std::size_t output) const;
+  double held_out_rms(const Scored& s, std::size_t output) const;  // of the residual
   // Effective sample count of a model's estimation residual (docs/diagnosis.md 5).
   double n_eff(const Scored& s) const;
   // The same on some outputs only (empty: all): their weighted estimation

@@ -42,12 +42,6 @@ const std::map<std::string, Setter>& quarter_car_setters() {
       {"mu", [](QuarterCarParams& p, double v) { p.bearing_friction.normal_coefficient = v; }},
       {"delta", [](QuarterCarParams& p, double v) { p.hidden.valve_overlap = v; }},
       {"F_pr", [](QuarterCarParams& p, double v) { p.hidden.seal_preload = v; }},
-      // Entrained air as the candidate fits it: the mixture law with its
-      // bubble index (tools/diagnosis/models/quarter_car.cpp kBubbleIndex).
-      {"alpha", [](QuarterCarParams& p, double v) {
-         p.hidden.air_fraction = v;
-         p.hidden.air_polytropic_index = 1.2;
-       }},
       {"f_c", [](QuarterCarParams& p, double v) { p.hidden.seal_pressure_coefficient = v; }},
   };
   return s;
@@ -74,11 +68,19 @@ DiagnosisModel diagnosis_model(const RigConfig& nominal, const std::string& path
   }
   DiagnosisModel m{nominal, {}, {}};
   const auto& setters = quarter_car_setters();
+  // The values the candidates' laws are written around (the diagnosis's
+  // `model_constants`): the pressure sum the seal's level F_m is at, the
+  // air's bubble index. A parameter whose constant the file lacks (a
+  // diagnosis from before they were written) is ignored, not guessed.
+  const YAML::Node constants = root["model_constants"];
+  auto constant = [&](const char* key) { return constants && constants[key] ? constants[key].as<double>() : -1.0; };
+  const double seal_sum = constant("P_m"), bubble_index = constant("air_bubble_index");
   double beta_ratio = 1.0;     // entrained air as a constant ratio (diagnoses before the mixture law)
-  double seal_level = -1.0;    // F_m: the seal's Coulomb level at the run's mean pressure sum
+  double seal_level = -1.0;    // F_m: the seal's Coulomb level at the pressure sum P_m
   for (const auto& kv : root["final_parameters"]) {
     const std::string name = kv.first.as<std::string>();
-    if (kv.second.IsNull()) {  // undetermined by the run: the config's value stays
+    const bool needs_constant = (name == "F_m" && seal_sum < 0.0) || (name == "alpha" && bubble_index < 0.0);
+    if (kv.second.IsNull() || needs_constant) {  // undetermined, or not mappable: the config's value stays
       m.ignored.push_back(name);
       continue;
     }
@@ -89,6 +91,10 @@ DiagnosisModel diagnosis_model(const RigConfig& nominal, const std::string& path
     } else if (name == "F_m") {
       seal_level = value;
       m.applied.push_back(name);
+    } else if (name == "alpha") {  // entrained air by the mixture law, with the candidate's bubbles
+      m.config.quarter_car.hidden.air_fraction = value;
+      m.config.quarter_car.hidden.air_polytropic_index = bubble_index;
+      m.applied.push_back(name);
     } else if (const auto it = setters.find(name); it != setters.end()) {
       it->second(m.config.quarter_car, value);
       m.applied.push_back(name);
@@ -96,14 +102,12 @@ DiagnosisModel diagnosis_model(const RigConfig& nominal, const std::string& path
       m.ignored.push_back(name);
     }
   }
-  m.config.quarter_car.bulk_modulus *= beta_ratio;
-  // The plant's seal law has a preload and a pressure term; the fitted level
-  // is at the run's mean p1 + p2, which the JSON does not carry: taken at
-  // the supply pressure, the sum at rest of a symmetric valve (a run's mean
-  // is within a few per cent of it).
   auto& q = m.config.quarter_car;
+  q.bulk_modulus *= beta_ratio;
+  // The plant's seal law is a preload and a pressure term: the level F_m at
+  // P_m less the term there.
   if (seal_level >= 0.0)
-    q.hidden.seal_preload = std::max(0.0, seal_level - q.hidden.seal_pressure_coefficient * q.supply_pressure);
+    q.hidden.seal_preload = std::max(0.0, seal_level - q.hidden.seal_pressure_coefficient * seal_sum);
   return m;
 }
 

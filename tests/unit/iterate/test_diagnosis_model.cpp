@@ -36,18 +36,33 @@ TEST(DiagnosisModel, FinalParametersGoIntoThePlantUndeterminedOnesStay) {
   EXPECT_EQ(m.ignored, (std::vector<std::string>{"Mw", "tau"}));  // tau: a sensor's delay, not the plant's
 }
 
-// The candidates' own parameters: entrained air as the mixture law's air
-// fraction (with the candidate's bubble index), the seal's level at the
-// run's mean pressure sum taken at the supply pressure.
+// The candidates' own parameters, through the constants their laws are
+// written around: entrained air as the mixture law's air fraction with the
+// candidate's bubble index, the seal's level F_m at the pressure sum P_m
+// (not the supply pressure: six generated runs had a mean p1 + p2 of 73-79 %
+// of it).
 TEST(DiagnosisModel, AirFractionAndSealLevelGoIntoThePlant) {
   const auto m = diagnosis_model(quarter_car(), write("a.json", R"({"rig": "quarter_car", "cause": "entrained_air",
-      "final_parameters": {"alpha": 0.05, "F_m": 300.0, "f_c": 5.0e-6, "Ps": 2.0e7}})"));
+      "final_parameters": {"alpha": 0.05, "F_m": 300.0, "f_c": 5.0e-6, "Ps": 2.0e7},
+      "model_constants": {"P_m": 1.5e7, "air_bubble_index": 1.2}})"));
   const QuarterCarParams& p = m.config.quarter_car;
   EXPECT_DOUBLE_EQ(p.hidden.air_fraction, 0.05);
   EXPECT_DOUBLE_EQ(p.hidden.air_polytropic_index, 1.2);
   EXPECT_DOUBLE_EQ(p.hidden.seal_pressure_coefficient, 5.0e-6);
-  EXPECT_NEAR(p.hidden.seal_preload, 300.0 - 5.0e-6 * 2.0e7, 1e-9);
+  EXPECT_NEAR(p.hidden.seal_preload, 300.0 - 5.0e-6 * 1.5e7, 1e-9);
   EXPECT_TRUE(m.ignored.empty());
+}
+
+// Without the constants (a diagnosis written before them) the level and the
+// air fraction cannot be placed: the config's values stay, and they are
+// listed as ignored rather than mapped at a guessed pressure.
+TEST(DiagnosisModel, ALevelWithoutItsConstantIsIgnoredNotGuessed) {
+  const RigConfig nominal = quarter_car();
+  const auto m = diagnosis_model(nominal, write("b.json", R"({"rig": "quarter_car", "cause": "entrained_air",
+      "final_parameters": {"alpha": 0.05, "F_m": 300.0, "f_c": 5.0e-6}})"));
+  EXPECT_EQ(m.ignored, (std::vector<std::string>{"alpha", "F_m"}));
+  EXPECT_DOUBLE_EQ(m.config.quarter_car.hidden.seal_preload, nominal.quarter_car.hidden.seal_preload);
+  EXPECT_DOUBLE_EQ(m.config.quarter_car.hidden.air_fraction, nominal.quarter_car.hidden.air_fraction);
 }
 
 TEST(DiagnosisModel, TheShippedDiagnosisMapsOntoTheQuarterCar) {

@@ -235,6 +235,9 @@ class QuarterCarModel : public RigModel {
     if (cause == "tyre_liftoff" || cause == "sensor_offset") return true;
     return !suspension_param || shared;
   }
+  std::map<std::string, double> constants() const override {
+    return {{"P_m", seal_sum_}, {"air_bubble_index", kBubbleIndex}};
+  }
   std::vector<std::size_t> acts_on(const std::string& cause) const override {
     if (cause == "tyre_liftoff" || cause == "sensor_offset") return {};  // both sub-models
     const std::size_t ft = 2 + act_outputs_;
@@ -274,8 +277,7 @@ class QuarterCarModel : public RigModel {
       y[1] = std::move(part[1]);
       if (has_ft) y[ft] = std::move(part[2]);
     } else {
-      std::vector<double> unused;
-      simulate_suspension(th, y[0], y[1], has_ft ? y[ft] : unused, samples);
+      simulate_suspension(th, y[0], y[1], has_ft ? &y[ft] : nullptr, samples);
       if (has_ft) susp_cache_.put(ks, {y[0], y[1], y[ft]});
       else susp_cache_.put(ks, {y[0], y[1]});
     }
@@ -320,11 +322,9 @@ class QuarterCarModel : public RigModel {
   }
 
  private:
-  // yf: the tyre load (static part included), filled when it has the
-  // record's length.
+  // yf: the tyre load (static part included), where the run has it.
   void simulate_suspension(const std::vector<double>& th, std::vector<double>& yb, std::vector<double>& yw,
-                           std::vector<double>& yf, std::size_t samples) const {
-    const bool load = yf.size() == t_.size();
+                           std::vector<double>* yf, std::size_t samples) const {
     const double ks = th[kKs], bd = th[kBd], Fc = th[kFc], dFs = th[kDFs], D = th[kD], mu = th[kMu], dc = th[kDc],
                  tau = th[kTau], b_b = th[kBb], b_w = th[kBw], uni = th[kUni];
     const std::size_t n = t_.size();
@@ -340,7 +340,7 @@ class QuarterCarModel : public RigModel {
       yw[i] = xw + b_w;
       const double xr0 = xr_[i], xr1 = i + 1 < n ? xr_[i + 1] : xr_[i];
       const double vr = (xr1 - xr0) / dt_;
-      if (load) yf[i] = tyre_contact(f0 + kt * (xr0 - xw) + bt * (vr_load_[i] - vw), uni);
+      if (yf) (*yf)[i] = tyre_contact(f0 + kt * (xr0 - xw) + bt * (vr_load_[i] - vw), uni);
       for (int s = 0; s < sub; ++s) {
         const double xr = xr0 + (xr1 - xr0) * (s + 0.5) / sub;
         const double vrel = vw - vb;
@@ -360,7 +360,7 @@ class QuarterCarModel : public RigModel {
       }
       if (!std::isfinite(xb) || !std::isfinite(xw)) {
         for (std::size_t j = i; j < n; ++j) yb[j] = yw[j] = 1e3;
-        if (load) std::fill(yf.begin() + static_cast<std::ptrdiff_t>(i), yf.end(), 1e9);
+        if (yf) std::fill(yf->begin() + static_cast<std::ptrdiff_t>(i), yf->end(), 1e9);
         return;
       }
     }
