@@ -103,6 +103,12 @@ TEST(DiagnosisCriteria, TheUnexplainedTestIsTheOneTheGateUses) {
   EXPECT_TRUE(misfits_beyond_noise(kUnexplainedExcess, kUnexplainedFit - 0.1));
   EXPECT_FALSE(misfits_beyond_noise(kUnexplainedExcess - 0.1, 90.0));
   EXPECT_FALSE(misfits_beyond_noise(10.0, kUnexplainedFit));
+  // The lower floor opens exactly where a `none` would be `unexplained`: a
+  // candidate that takes the residual to the noise from just below the
+  // threshold gets the full floor, from the threshold the lower one.
+  EXPECT_FALSE(explains_misfit(evidence(0.7, kUnexplainedExcess - 0.01, 1.0)));
+  EXPECT_TRUE(explains_misfit(evidence(0.7, kUnexplainedExcess, 1.0)));
+  EXPECT_FALSE(explains_misfit(evidence(0.7, 10.0, 1.0, kUnexplainedFit)));
 }
 
 }  // namespace
