@@ -1,0 +1,101 @@
+// MIMO drive iteration on the simulated hydraulic two-poster rig
+// (plant/two_poster, closed by two PI loops written in the test): the
+// matrix of FRFs from the two posts' demands to the body's displacement
+// over both axles measured with orthogonal multisines, then a target over
+// both axles that a road played on this rig made, with a seal-wear leak
+// and seal friction on the rear post that the FRF measurement saw but no
+// model holds, reached within six iterations, each better than the last.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "plant/two_poster/two_poster_plant.hpp"
+#include "tools/identify/mimo_excitation.hpp"
+#include "tools/identify/mimo_frf.hpp"
+#include "tools/iterate/mimo_iteration.hpp"
+#include "tools/iterate/spectrum.hpp"
+#include "two_poster_loops.hpp"
+
+namespace rigctl {
+namespace {
+
+namespace sig = two_poster_signal;
+constexpr double kPeriod = 0.0025;
+constexpr std::size_t kTicks = 4000;  // 10 s periods: 0.1 Hz lines
+
+TwoPosterParams rig_with_effects() {
+  TwoPosterParams p;
+  p.posts[1].extra_laminar_leak = 2e-12;  // [m^3/s/Pa] seal wear: 1.5 x the nominal leak
+  p.posts[1].seal_friction = 150.0;       // [N] rod seal
+  return p;
+}
+
+Records play(const TwoPosterParams& params, const Records& demands) {
+  TwoPosterPlant plant(params);
+  const double a = params.car.dist_front, b = params.car.dist_rear;
+  return test::TwoPosterLoops{}.play(plant, demands, [&](const auto& y) {
+    return std::vector<double>{y[sig::kZs] + a * y[sig::kPhi], y[sig::kZs] - b * y[sig::kPhi]};
+  });
+}
+
+MimoFrf measured_frf(const TwoPosterParams& params) {
+  std::vector<std::size_t> lines;
+  for (std::size_t k = 5; k <= 200; ++k) lines.push_back(k);  // 0.5 .. 20 Hz
+  const auto e = orthogonal_multisines(lines, kTicks, 2, 4, 0.003, 5);
+  const auto played = played_records(e, 1);
+  const auto drives = steady_periods(played, e, 1);
+  const auto responses = steady_periods(play(params, played), e, 1);
+  const WelchSettings welch{kTicks, kTicks, SpectralWindow::kRectangular, 1.0 / kPeriod};
+  return estimate_mimo_frf({drives.begin(), drives.end()}, {responses.begin(), responses.end()}, welch, 0.5, 20.0, lines);
+}
+
+// A road under both axles (0.5-20 Hz, 1/f^2 displacement, 3 mm rms, the
+// rear the front's 0.134 s later plus its own part), around 20 mm up.
+Records track_target(const TwoPosterParams& params) {
+  const std::size_t n = 8000;
+  std::mt19937_64 rng(21);
+  std::normal_distribution<double> normal;
+  auto road = [&] {
+    std::vector<double> w(n);
+    for (double& v : w) v = normal(rng);
+    Spectrum s = forward_fft(w);
+    for (std::size_t k = 0; k < n; ++k) {
+      const double f = bin_frequency_hz(k, n, kPeriod);
+      s[k] *= (f < 0.5 || f > 20.0) ? 0.0 : 1.0 / (f * f);
+    }
+    return inverse_fft(s);
+  };
+  const auto front = road(), side = road();
+  double rms = 0.0;
+  for (double v : front) rms += v * v;
+  const double scale = 0.003 / std::sqrt(rms / n);
+  const auto delay = static_cast<std::size_t>(std::lround(0.134 / kPeriod));
+  Records drives(2, std::vector<double>(n));
+  for (std::size_t i = 0; i < n; ++i) {
+    const double taper = std::min({1.0, i / 400.0, (n - 1 - i) / 400.0});
+    drives[0][i] = scale * taper * front[i];
+    drives[1][i] = scale * taper * (0.7 * (i >= delay ? front[i - delay] : 0.0) + 0.3 * side[i]);
+  }
+  return play(params, drives);
+}
+
+TEST(TwoPosterIteration, ReachesATargetOverBothAxlesOnTheHydraulicRig) {
+  const TwoPosterParams params = rig_with_effects();
+  const auto target = track_target(params);
+  MimoInverseSettings settings;
+  settings.band_min_hz = 0.5;
+  settings.band_max_hz = 20.0;
+  const MimoDriveInverse inverse(measured_frf(params), target.front().size(), kPeriod, settings);
+  const auto result = iterate_mimo(inverse, target, [&](const Records& d) { return play(params, d); }, MimoIterationSettings{});
+  for (std::size_t it = 0; it < result.error.size(); ++it) {
+    std::printf("iteration %zu: front %.4f rear %.4f\n", it + 1, result.error[it][0], result.error[it][1]);
+  }
+  ASSERT_TRUE(result.converged);
+  for (std::size_t it = 1; it < result.error.size(); ++it) {
+    for (std::size_t j = 0; j < 2; ++j) EXPECT_LT(result.error[it][j], result.error[it - 1][j]);
+  }
+}
+
+}  // namespace
+}  // namespace rigctl
