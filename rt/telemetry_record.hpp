@@ -14,7 +14,8 @@ namespace rigctl {
 
 inline constexpr std::size_t kMaxControllerTerms = 8;
 
-// The controller's inside view for one tick; term names come from
+// The controller's inside view for one tick (what each field holds:
+// rt/control/controller.hpp); term names come from
 // Controller::term_names(), fixed at start-up.
 struct ControllerTerms {
   double setpoint = 0.0;

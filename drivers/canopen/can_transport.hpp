@@ -2,8 +2,8 @@
 // read or write. In production the fd is a SocketCAN CAN_RAW socket
 // (drivers/canopen/socketcan.hpp); in tests and in the simulated rig it is a
 // SOCK_SEQPACKET unix socket, which keeps the same one-frame-per-record
-// semantics (the development and CI kernel has no CAN at all: README,
-// "What was tested where").
+// semantics (the development and CI kernel has no CAN at all:
+// docs/hardware.md, "What was tested where").
 //
 // send() never blocks: the real-time loop may call it. A full socket buffer
 // (EAGAIN, or ENOBUFS from a CAN driver whose tx queue is full) drops the

@@ -148,11 +148,10 @@ class ModbusDaq {
   struct OutputCommand {
     std::array<double, kMaxOutputs> value{};
   };
-  class Io;  // the I/O thread's state (libmodbus context, plans, buffers)
+  class Io;  // the I/O thread: its state (libmodbus context, plans, buffers) and steps (modbus_daq_io.hpp)
   static OutputCommand safe_command(const ModbusDaqConfig& config);
   static InputSnapshot never_read();
 
-  void run_io() noexcept;
   void add_event(std::string text);  // with mutex_ held
 
   ModbusDaqConfig config_;

@@ -29,13 +29,7 @@ void FuzzySuspensionController::update(double setpoint, const Sample& sample, Co
   write_forces(command, config_.channels, force[0], force[1]);
   terms.term[0] = force[0];
   terms.term[1] = force[1];
-  terms.setpoint = setpoint;
-  terms.measurement = sample_at(sample, config_.channels.z_s);
-  terms.error = setpoint - terms.measurement;
-  terms.output_unsaturated = raw[0];
-  terms.output = force[0];
-  terms.saturated = raw[0] != force[0] || raw[1] != force[1];
-  terms.integrator_held = false;
+  fill_suspension_terms(terms, setpoint, sample, config_.channels, raw, force);
 }
 
 }  // namespace rigctl

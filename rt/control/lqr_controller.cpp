@@ -84,7 +84,7 @@ void LqrController::update(double setpoint, const Sample& sample, Command& comma
                                    sample_at(sample, ch.z_u1),           sample_at(sample, ch.z_u2),
                                    sample_at(sample, ch.z_s_dot),        sample_at(sample, ch.phi_dot),
                                    sample_at(sample, ch.z_u1_dot),       sample_at(sample, ch.z_u2_dot)};
-  double raw[2], force[2];
+  std::array<double, 2> raw{}, force{};
   for (std::size_t r = 0; r < 2; ++r) {
     const auto& k = config_.gain[r];
     const double body = -(k[0] * x[0] + k[1] * x[1] + k[4] * x[4] + k[5] * x[5]);
@@ -97,13 +97,7 @@ void LqrController::update(double setpoint, const Sample& sample, Command& comma
   write_forces(command, ch, force[0], force[1]);
   terms.term[0] = force[0];
   terms.term[1] = force[1];
-  terms.setpoint = setpoint;
-  terms.measurement = sample_at(sample, ch.z_s);
-  terms.error = setpoint - terms.measurement;
-  terms.output_unsaturated = raw[0];
-  terms.output = force[0];
-  terms.saturated = raw[0] != force[0] || raw[1] != force[1];
-  terms.integrator_held = false;
+  fill_suspension_terms(terms, setpoint, sample, ch, raw, force);
 }
 
 }  // namespace rigctl

@@ -43,16 +43,15 @@ void PiController::update(double setpoint, const Sample& sample, Command& comman
   const double output = std::clamp(unsaturated, -limit, limit);
 
   command.value[static_cast<std::size_t>(config_.output_index)] = output;
-  terms.setpoint = setpoint;
-  terms.measurement = measurement;
-  terms.error = error;
   terms.term[0] = p;
   terms.term[1] = integrator_;
   terms.term[2] = ff;  // published only when "ff" is among the term names
-  terms.output_unsaturated = unsaturated;
-  terms.output = output;
-  terms.saturated = unsaturated != output;
-  terms.integrator_held = held;
+  fill_terms(terms, {.setpoint = setpoint,
+                     .measurement = measurement,
+                     .unsaturated = unsaturated,
+                     .output = output,
+                     .saturated = unsaturated != output,
+                     .integrator_held = held});
 }
 
 }  // namespace rigctl

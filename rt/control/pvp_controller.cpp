@@ -44,17 +44,15 @@ void PvpController::update(double setpoint, const Sample& sample, Command& comma
   const double output = std::clamp(unsaturated, -config_.output_limit, config_.output_limit);
 
   command.value[static_cast<std::size_t>(config_.output_index)] = output;
-  terms.setpoint = setpoint;
-  terms.measurement = angle;
-  terms.error = error;
   terms.term[0] = e_part;
   terms.term[1] = p_part;
   terms.term[2] = v_part;
   terms.term[3] = omega_;
-  terms.output_unsaturated = unsaturated;
-  terms.output = output;
-  terms.saturated = unsaturated != output;
-  terms.integrator_held = false;
+  fill_terms(terms, {.setpoint = setpoint,
+                     .measurement = angle,
+                     .unsaturated = unsaturated,
+                     .output = output,
+                     .saturated = unsaturated != output});
 }
 
 }  // namespace rigctl

@@ -13,7 +13,7 @@ SkyhookController::SkyhookController(const SkyhookConfig& config) : config_(conf
 void SkyhookController::update(double setpoint, const Sample& sample, Command& command,
                                ControllerTerms& terms) noexcept {
   const BodyCorners corners = body_corners(sample, config_.channels, config_.lever_arm);
-  double raw[2], force[2];
+  std::array<double, 2> raw{}, force{};
   for (std::size_t i = 0; i < 2; ++i) {
     raw[i] = -config_.c_sky * corners.velocity[i];
     force[i] = std::clamp(raw[i], -config_.force_limit, config_.force_limit);
@@ -23,13 +23,7 @@ void SkyhookController::update(double setpoint, const Sample& sample, Command& c
   terms.term[1] = force[1];
   terms.term[2] = corners.velocity[0];
   terms.term[3] = corners.velocity[1];
-  terms.setpoint = setpoint;
-  terms.measurement = sample_at(sample, config_.channels.z_s);
-  terms.error = setpoint - terms.measurement;
-  terms.output_unsaturated = raw[0];
-  terms.output = force[0];
-  terms.saturated = raw[0] != force[0] || raw[1] != force[1];
-  terms.integrator_held = false;
+  fill_suspension_terms(terms, setpoint, sample, config_.channels, raw, force);
 }
 
 }  // namespace rigctl

@@ -20,15 +20,19 @@ void write_forces(Command& command, const SuspensionChannels& ch, double f1, dou
   command.value[static_cast<std::size_t>(ch.output_2)] = f2;
 }
 
+void fill_suspension_terms(ControllerTerms& terms, double setpoint, const Sample& sample, const SuspensionChannels& ch,
+                           const std::array<double, 2>& raw, const std::array<double, 2>& force) noexcept {
+  fill_terms(terms, {.setpoint = setpoint,
+                     .measurement = sample_at(sample, ch.z_s),
+                     .unsaturated = raw[0],
+                     .output = force[0],
+                     .saturated = raw[0] != force[0] || raw[1] != force[1]});
+}
+
 void PassiveSuspensionController::update(double setpoint, const Sample& sample, Command& command,
                                          ControllerTerms& terms) noexcept {
   write_forces(command, channels_, 0.0, 0.0);
-  terms.setpoint = setpoint;
-  terms.measurement = sample_at(sample, channels_.z_s);
-  terms.error = setpoint - terms.measurement;
-  terms.output_unsaturated = terms.output = 0.0;
-  terms.saturated = false;
-  terms.integrator_held = false;
+  fill_suspension_terms(terms, setpoint, sample, channels_, {0.0, 0.0}, {0.0, 0.0});
 }
 
 }  // namespace rigctl

@@ -56,6 +56,12 @@ BodyCorners body_corners(const Sample& s, const SuspensionChannels& ch, const Le
 
 void write_forces(Command& command, const SuspensionChannels& ch, double f1, double f2) noexcept;
 
+// The terms every half-car controller reports besides its own (fill_terms):
+// the body heave z_s against the demand, the first force before (raw) and
+// after its limit, saturated when either force was limited.
+void fill_suspension_terms(ControllerTerms& terms, double setpoint, const Sample& sample, const SuspensionChannels& ch,
+                           const std::array<double, 2>& raw, const std::array<double, 2>& force) noexcept;
+
 // Passive suspension: both actuator forces 0. Terms: none.
 class PassiveSuspensionController final : public Controller {
  public:

@@ -19,7 +19,7 @@ struct CmdOptions {
   std::string command;           // arm start hold resume stop reset hydraulics-low hydraulics-high hydraulics-off setpoint
   std::string value;             // setpoint only: the new setpoint, SI units
   std::string key_path;          // required
-  std::string lcm_url = "udpm://239.255.76.67:7667?ttl=1";  // the rig network (README, Telemetry)
+  std::string lcm_url = "udpm://239.255.76.67:7667?ttl=1";  // the rig network (docs/running.md, Telemetry)
   std::string channel = "RIGCTL_OPERATOR";
   std::string ack_channel;       // "": <channel>_ACK
   std::string sender;            // "": USER@HOSTNAME, cleaned to a valid sender id

@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
-# Commissions both simulated rigs from a proportional stabiliser, as the
-# README's "Commissioning" section shows: rigctl identify, rigctl tune (FRF
+# Commissions both simulated rigs from a proportional stabiliser, as
+# docs/frf-files.md section 5 shows: rigctl identify, rigctl tune (FRF
 # design and relay Ziegler-Nichols), the tuned loop measured again, and the
 # standard step test of the start, the shipped, the tuned and the relay
 # gains. Plots go to docs/figures/commissioning/ (or the folder given); the
-# numbers (BENCHMARKS.md "Commissioning") are printed.
+# numbers (docs/benchmarks/commissioning.md) are printed.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
 out=${1:-$root/docs/figures/commissioning}
@@ -18,7 +18,7 @@ rigctl="$root/build/tools/rigctl"
 commission() {
   local rig=$1 tag=$2 edit=$3 pm=$4 gain=$5
   local dir="$work/$tag" config="$root/config/$rig.yaml" plots=$out
-  [ "$tag" = "$rig" ] || plots="$work/$tag"  # a changed plant: its plots stay out of the README's
+  [ "$tag" = "$rig" ] || plots="$work/$tag"  # a changed plant: its plots stay out of the docs'
   mkdir -p "$dir"
   sed -e "$edit" "$config" > "$dir/start.yaml"
   echo "== $tag (start: stabiliser gain $gain, target phase margin $pm deg)"

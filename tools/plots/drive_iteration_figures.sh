@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# The drive iteration of the README's "Road simulator" section and
-# BENCHMARKS.md "Drive iteration": ISO 8608 road targets (class C at 2 m/s,
+# The drive iteration of docs/drive-iteration.md section 8 and
+# docs/benchmarks/drive-iteration.md: ISO 8608 road targets (class C at 2 m/s,
 # class D at 1 m/s) reproduced by the simulated quarter car with its bearing
 # friction, its laminar leakage and a worn piston seal the nominal model
 # lacks, with the inverse from the nominal model, from the model a

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iomanip>
 #include <sstream>
 #include <stdexcept>
@@ -173,6 +174,78 @@ std::string percent_text(double v) {
   return fixed(v, 1) + " %";
 }
 
+// The bump's part of the account: why the tyre, the body and the settling
+// differ from the paper's figures.
+void explain_bump(const CompareResult& r, const HalfCarParams& p, double force_limit, std::ostream& out) {
+  const auto& pas = r.metrics[0];
+  const auto& fuz = r.metrics[1];
+  const double hump_ms = 1e3 * p.road.bump.wavelength / p.speed;
+  out << "* The bump: at V = " << p.speed << " m/s one hump of lambda0 = " << p.road.bump.wavelength
+      << " m lasts " << fixed(hump_ms, 1) << " ms, a " << fixed(1e3 / hump_ms, 0)
+      << " Hz event far above wheel hop (~10 Hz) and the body modes (~1.3-1.6 Hz). The tyre swallows it: the "
+         "peak tyre deflection is "
+      << fixed(1e3 * worse(pas.peak_tyre_deflection), 1) << " mm passive and "
+      << fixed(1e3 * worse(fuz.peak_tyre_deflection), 1)
+      << " mm fuzzy, set by the road before a force limited to " << fixed(force_limit, 0)
+      << " N can move a wheel, so no controller here reproduces the paper's 28.5 % tyre reduction ("
+      << percent_text(reduction_percent(worse(pas.peak_tyre_deflection), worse(fuz.peak_tyre_deflection)))
+      << "). The paper's Figs. 2 and 6-27 are missing from its text, so its bump's real timing cannot be checked.\n";
+  out << "* Body displacement: the impulse barely lifts the body (passive peak " << fixed(1e3 * pas.peak_z_s, 2)
+      << " mm); the fuzzy controller takes " << percent_text(reduction_percent(pas.peak_z_s, fuz.peak_z_s))
+      << " off it against the paper's 74.2 %. Its membership functions (Figs. 3-4) and the input and force "
+         "scaling are not in the text: ours are stated choices in the config, not tuned to a result.\n";
+  // When the passive peak comes, against the wheels' arrival at the bump.
+  const auto& acc = r.runs[0].run.z_s_ddot;
+  std::size_t k_peak = 0;
+  for (std::size_t k = 0; k < acc.size(); ++k) {
+    if (std::abs(acc[k]) > std::abs(acc[k_peak])) k_peak = k;
+  }
+  const double t_peak = static_cast<double>(k_peak) * r.runs[0].run.dt;
+  const double arrival[2] = {p.road.bump.start_time,
+                             p.road.bump.start_time + (p.plane == HalfCarPlane::kPitch && p.road.wheels == RoadWheels::kBoth
+                                                           ? (p.dist_front + p.dist_rear) / p.speed
+                                                           : 0.0)};
+  const int wheel = (p.road.wheels == RoadWheels::kWheel2 || (p.road.wheels == RoadWheels::kBoth && t_peak >= arrival[1]))
+                        ? 1 : 0;
+  out << "* Body acceleration: the passive peak (" << fixed(pas.peak_acc, 2) << " m/s^2) comes "
+      << fixed(1e3 * (t_peak - arrival[wheel]), 1) << " ms after wheel " << wheel + 1
+      << " reaches the bump: the humps' impulse reaches the body through the spring and damper within a few "
+         "loop periods (2.5 ms), and the controllers push on the body with at most "
+      << fixed(force_limit, 0) << " N; they cannot stop the wheel. Fuzzy takes "
+      << percent_text(reduction_percent(pas.peak_acc, fuz.peak_acc)) << " off the peak, "
+      << percent_text(reduction_percent(pas.rms_acc, fuz.rms_acc)) << " off the RMS and "
+      << percent_text(reduction_percent(pas.wk_rms_acc, fuz.wk_rms_acc))
+      << " off the Wk-weighted RMS, against the paper's 88.72 % (peak).\n";
+  out << "* Settling: the paper gives no band; ours is +-" << fixed(1e3 * r.settling_band, 3)
+      << " mm (a fixed share of the passive peak) for every run. Passive settles in "
+      << fixed(pas.settling_time, 2) << " s (paper 6 s), fuzzy in " << fixed(fuz.settling_time, 2)
+      << " s (paper 3.5 s).\n";
+}
+
+// The curve's part: the steady roll each controller leaves.
+void explain_curve(const CompareResult& r, const HalfCarParams& p, std::ostream& out) {
+  const auto& pas = r.metrics[0];
+  const auto& fuz = r.metrics[1];
+  const auto& types = suspension_controller_types();
+  out << "* Curve: the centrifugal roll moment (" << fixed(half_car_roll_moment(p), 0)
+      << " N m) is a steady load. Roll angle at the end of the run:";
+  for (std::size_t k = 0; k < r.runs.size(); ++k) {
+    out << (k ? ", " : " ") << types[k] << " " << fixed(1e3 * r.runs[k].run.phi.back(), 1) << " mrad";
+  }
+  out << "; peak: passive " << fixed(1e3 * pas.peak_phi, 1) << ", fuzzy " << fixed(1e3 * fuz.peak_phi, 1)
+      << " mrad. Fuzzy and skyhook act on body corner velocity and acceleration only: they damp the roll "
+         "transient but leave the steady roll to the springs.";
+  const auto& lqr = r.runs[3].run;
+  if (std::abs(lqr.phi.back()) > 1.05 * std::abs(r.runs[0].run.phi.back())) {
+    out << " LQR regulates the wheel displacements to zero as well (the tyre deflection on a level road), but in "
+           "a curve the load transfer fixes the tyre deflections, so it drives the actuators to "
+        << fixed(lqr.force[0].back(), 0) << " / " << fixed(lqr.force[1].back(), 0)
+        << " N and rolls the body further: a limit of that state choice (no load-transfer or road state, no "
+           "integral action), reported as it is.";
+  }
+  out << "\n";
+}
+
 // The account of the differences, with this run's numbers in it.
 void explain(const CompareResult& r, const HalfCarParams& p, double force_limit, const FuzzyEngineSpec& fuzzy,
              std::ostream& out) {
@@ -185,49 +258,7 @@ void explain(const CompareResult& r, const HalfCarParams& p, double force_limit,
     out << "* The paper's figures are for its bump in the pitch plane; this run is a " << describe_road(p)
         << ", so the paper's column is for orientation only.\n";
   }
-  if (p.road.kind == RoadKind::kBump) {
-    const double hump_ms = 1e3 * p.road.bump.wavelength / p.speed;
-    out << "* The bump: at V = " << p.speed << " m/s one hump of lambda0 = " << p.road.bump.wavelength
-        << " m lasts " << fixed(hump_ms, 1) << " ms, a " << fixed(1e3 / hump_ms, 0)
-        << " Hz event far above wheel hop (~10 Hz) and the body modes (~1.3-1.6 Hz). The tyre swallows it: the "
-           "peak tyre deflection is "
-        << fixed(1e3 * worse(pas.peak_tyre_deflection), 1) << " mm passive and "
-        << fixed(1e3 * worse(fuz.peak_tyre_deflection), 1)
-        << " mm fuzzy, set by the road before a force limited to " << fixed(force_limit, 0)
-        << " N can move a wheel, so no controller here reproduces the paper's 28.5 % tyre reduction ("
-        << percent_text(reduction_percent(worse(pas.peak_tyre_deflection), worse(fuz.peak_tyre_deflection)))
-        << "). The paper's Figs. 2 and 6-27 are missing from its text, so its bump's real timing cannot be checked.\n";
-    out << "* Body displacement: the impulse barely lifts the body (passive peak " << fixed(1e3 * pas.peak_z_s, 2)
-        << " mm); the fuzzy controller takes " << percent_text(reduction_percent(pas.peak_z_s, fuz.peak_z_s))
-        << " off it against the paper's 74.2 %. Its membership functions (Figs. 3-4) and the input and force "
-           "scaling are not in the text: ours are stated choices in the config, not tuned to a result.\n";
-    // When the passive peak comes, against the wheels' arrival at the bump.
-    const auto& acc = r.runs[0].run.z_s_ddot;
-    std::size_t k_peak = 0;
-    for (std::size_t k = 0; k < acc.size(); ++k) {
-      if (std::abs(acc[k]) > std::abs(acc[k_peak])) k_peak = k;
-    }
-    const double t_peak = static_cast<double>(k_peak) * r.runs[0].run.dt;
-    const double arrival[2] = {p.road.bump.start_time,
-                               p.road.bump.start_time + (p.plane == HalfCarPlane::kPitch && p.road.wheels == RoadWheels::kBoth
-                                                             ? (p.dist_front + p.dist_rear) / p.speed
-                                                             : 0.0)};
-    const int wheel = (p.road.wheels == RoadWheels::kWheel2 || (p.road.wheels == RoadWheels::kBoth && t_peak >= arrival[1]))
-                          ? 1 : 0;
-    out << "* Body acceleration: the passive peak (" << fixed(pas.peak_acc, 2) << " m/s^2) comes "
-        << fixed(1e3 * (t_peak - arrival[wheel]), 1) << " ms after wheel " << wheel + 1
-        << " reaches the bump: the humps' impulse reaches the body through the spring and damper within a few "
-           "loop periods (2.5 ms), and the controllers push on the body with at most "
-        << fixed(force_limit, 0) << " N; they cannot stop the wheel. Fuzzy takes "
-        << percent_text(reduction_percent(pas.peak_acc, fuz.peak_acc)) << " off the peak, "
-        << percent_text(reduction_percent(pas.rms_acc, fuz.rms_acc)) << " off the RMS and "
-        << percent_text(reduction_percent(pas.wk_rms_acc, fuz.wk_rms_acc))
-        << " off the Wk-weighted RMS, against the paper's 88.72 % (peak).\n";
-    out << "* Settling: the paper gives no band; ours is +-" << fixed(1e3 * r.settling_band, 3)
-        << " mm (a fixed share of the passive peak) for every run. Passive settles in "
-        << fixed(pas.settling_time, 2) << " s (paper 6 s), fuzzy in " << fixed(fuz.settling_time, 2)
-        << " s (paper 3.5 s).\n";
-  }
+  if (p.road.kind == RoadKind::kBump) explain_bump(r, p, force_limit, out);
   if (pas.rms_jerk > 1e-6 && fuz.rms_jerk > 1.2 * pas.rms_jerk) {
     const auto& in1 = fuzzy.inputs[0];
     out << "* Jerk: the fuzzy law is steep (its whole force range over +-" << fixed(in1.max / in1.scale, 3)
@@ -235,26 +266,7 @@ void explain(const CompareResult& r, const HalfCarParams& p, double force_limit,
         << fixed(fuz.rms_jerk, 1) << " m/s^3 against " << fixed(pas.rms_jerk, 1)
         << " passive (the paper reports less jerk with its controller).\n";
   }
-  if (p.plane == HalfCarPlane::kRoll && p.curve_radius != 0.0) {
-    const auto& types = suspension_controller_types();
-    out << "* Curve: the centrifugal roll moment (" << fixed(half_car_roll_moment(p), 0)
-        << " N m) is a steady load. Roll angle at the end of the run:";
-    for (std::size_t k = 0; k < r.runs.size(); ++k) {
-      out << (k ? ", " : " ") << types[k] << " " << fixed(1e3 * r.runs[k].run.phi.back(), 1) << " mrad";
-    }
-    out << "; peak: passive " << fixed(1e3 * pas.peak_phi, 1) << ", fuzzy " << fixed(1e3 * fuz.peak_phi, 1)
-        << " mrad. Fuzzy and skyhook act on body corner velocity and acceleration only: they damp the roll "
-           "transient but leave the steady roll to the springs.";
-    const auto& lqr = r.runs[3].run;
-    if (std::abs(lqr.phi.back()) > 1.05 * std::abs(r.runs[0].run.phi.back())) {
-      out << " LQR regulates the wheel displacements to zero as well (the tyre deflection on a level road), but in "
-             "a curve the load transfer fixes the tyre deflections, so it drives the actuators to "
-          << fixed(lqr.force[0].back(), 0) << " / " << fixed(lqr.force[1].back(), 0)
-          << " N and rolls the body further: a limit of that state choice (no load-transfer or road state, no "
-             "integral action), reported as it is.";
-    }
-    out << "\n";
-  }
+  if (p.plane == HalfCarPlane::kRoll && p.curve_radius != 0.0) explain_curve(r, p, out);
   out << "* The vehicle: Table 1 mixes a full car (M = 2160 kg, I_y = 4140, I_x = 946 kg m^2) with half-car "
          "equations; we simulate half of it (docs/rig-models.md 3.4.1) with springs and dampers inside Table 2. The "
          "paper's LQR figures (Wk RMS 0.2834 -> 0.0492 m/s^2) are quoted for its own LQR design, whose weights "
@@ -346,66 +358,86 @@ void write_recording_csv(const SuspensionRecording& rec, const std::string& path
   fs::rename(tmp, path);
 }
 
-CompareResult run_compare(const CompareOptions& options, std::ostream& out) {
-  const RigConfig config = load_rig_config(options.config_path, options.case_name);
-  if (config.rig != RigKind::kHalfCar) {
+namespace {
+
+// What one comparison runs: the config, checked for `compare`, and its settings.
+struct CompareSetup {
+  const CompareOptions& options;
+  RigConfig config;
+  double duration = 0.0;     // [s] simulated per run
+  double force_limit = 0.0;  // [N] per actuator
+  const HalfCarParams& car() const { return config.half_car; }
+};
+
+CompareSetup load_compare_setup(const CompareOptions& options) {
+  CompareSetup s{options, load_rig_config(options.config_path, options.case_name)};
+  if (s.config.rig != RigKind::kHalfCar) {
     throw ConfigError(options.config_path + ": rig: `rigctl compare` is for the half_car rig, this config is " +
-                      std::string(to_string(config.rig)));
+                      std::string(to_string(s.config.rig)));
   }
-  const double duration = config.profile.type == ProfileKind::kHold ? config.profile.duration_s : 0.0;
-  if (!(duration > 0.0)) {
+  s.duration = s.config.profile.type == ProfileKind::kHold ? s.config.profile.duration_s : 0.0;
+  if (!(s.duration > 0.0)) {
     throw ConfigError(options.config_path + ": profile.type: `rigctl compare` needs a `hold` profile (the body held at rest)");
   }
-  const HalfCarParams& p = config.half_car;
-  const double force_limit = config.controller.suspension.force_limit;
+  s.force_limit = s.config.controller.suspension.force_limit;
+  return s;
+}
 
-  CompareResult result;
-  result.out_dir = options.out_dir.empty()
-                       ? (fs::path(config.telemetry.log_dir) /
-                          ("half_car-compare" + (options.case_name.empty() ? "" : "-" + options.case_name)))
-                             .string()
-                       : options.out_dir;
-  fs::create_directories(result.out_dir);
+std::string compare_out_dir(const CompareSetup& s) {
+  const CompareOptions& o = s.options;
+  if (!o.out_dir.empty()) return o.out_dir;
+  return (fs::path(s.config.telemetry.log_dir) / ("half_car-compare" + (o.case_name.empty() ? "" : "-" + o.case_name)))
+      .string();
+}
 
-  out << "rigctl compare: half_car from " << options.config_path
-      << (options.case_name.empty() ? "" : " case " + options.case_name) << "\n"
-      << "  road: " << describe_road(p) << "; " << duration << " s simulated, loop " << config.loop.period_s * 1e3
-      << " ms, force limit " << force_limit << " N per actuator\n";
-  out.flush();
+// --- Computing: the four runs and their metrics.
 
-  const auto& types = suspension_controller_types();
+// Runs every suspension controller (on_run hears each as it ends), then
+// measures all against one settling band: a share of the passive run's peak.
+void compute_compare(const CompareSetup& s, CompareResult& result,
+                     const std::function<void(ControllerKind, const SuspensionRecording&)>& on_run) {
   for (const ControllerKind controller : suspension_controllers()) {
-    result.runs.push_back(run_half_car(config, controller, duration));
-    const auto& rec = result.runs.back();
-    out << "  " << std::left << std::setw(8) << controller << std::right << " " << rec.loop.ticks << " ticks, "
-        << to_string(rec.loop.final_state) << "\n";
-    out.flush();
+    result.runs.push_back(run_half_car(s.config, controller, s.duration));
+    on_run(controller, result.runs.back());
   }
-
-  // One settling band for every run: a share of the passive run's peak.
   const SuspensionMetrics passive_own = compute_suspension_metrics(result.runs[0].run);
-  const auto& rep = config.suspension_report;
+  const auto& rep = s.config.suspension_report;
   result.settling_band = std::max(rep.settling_band_fraction * passive_own.peak_z_s, rep.settling_min_band);
   SettlingSpec settling;
   settling.fraction = 0.0;
   settling.min_band = result.settling_band;
   for (const auto& rec : result.runs) result.metrics.push_back(compute_suspension_metrics(rec.run, settling));
+}
 
-  // The CSV files.
-  const std::string source = "rigctl compare " + options.config_path +
-                             (options.case_name.empty() ? "" : " --case " + options.case_name) +
+// --- Reporting: the text, the CSV files, the JSON.
+
+void print_compare_header(const CompareSetup& s, std::ostream& out) {
+  const CompareOptions& o = s.options;
+  out << "rigctl compare: half_car from " << o.config_path << (o.case_name.empty() ? "" : " case " + o.case_name)
+      << "\n"
+      << "  road: " << describe_road(s.car()) << "; " << s.duration << " s simulated, loop "
+      << s.config.loop.period_s * 1e3 << " ms, force limit " << s.force_limit << " N per actuator\n";
+  out.flush();
+}
+
+void write_compare_csvs(const CompareSetup& s, CompareResult& result) {
+  const CompareOptions& o = s.options;
+  const std::string source = "rigctl compare " + o.config_path + (o.case_name.empty() ? "" : " --case " + o.case_name) +
                              ": plant truth (noise-free); the loop ran on the sensor models; f_1, f_2 as commanded";
   for (const auto& rec : result.runs) {
     const std::string path = (fs::path(result.out_dir) / (rec.controller + ".csv")).string();
     write_recording_csv(rec, path, source);
     result.csv_paths.push_back(path);
   }
+}
 
-  // The table.
+// The metrics table, our reductions beside the paper's, the settling times.
+void print_metrics(const CompareSetup& s, const CompareResult& result, std::ostream& out) {
+  const auto& types = suspension_controller_types();
   out << "\nMetrics (plant truth; settling band +-" << fixed(1e3 * result.settling_band, 3) << " mm = "
-      << fixed(100.0 * rep.settling_band_fraction, 1) << " % of the passive peak, the same for every run):\n"
+      << fixed(100.0 * s.config.suspension_report.settling_band_fraction, 1)
+      << " % of the passive peak, the same for every run):\n"
       << format_metrics_table(types, result.metrics);
-  const PaperFigures paper;
   out << "\nReductions against passive (positive = smaller than passive), ours beside the paper's (its fuzzy "
          "controller unless marked):\n";
   char line[256];
@@ -428,6 +460,7 @@ CompareResult run_compare(const CompareOptions& options, std::ostream& out) {
   }
   out << "(paper: \"suspension travel improves by 56-60 %\" and \"active suspension travel increases by 56-60 %\": "
          "its text says both; -56..-60 % reads it as more travel.)\n";
+  const PaperFigures paper;
   out << "Settling time [s]: paper passive " << paper.settling_passive_s << ", active " << paper.settling_active_s
       << "; ours";
   for (std::size_t k = 0; k < types.size(); ++k) {
@@ -435,14 +468,17 @@ CompareResult run_compare(const CompareOptions& options, std::ostream& out) {
         << (result.metrics[k].settled ? "" : " (not settled)");
   }
   out << "\n";
+}
 
-  // Forces and contact: the checks, stated.
+// Forces and contact: the checks, stated.
+void print_forces_and_contact(const CompareSetup& s, const CompareResult& result, std::ostream& out) {
+  const auto& types = suspension_controller_types();
   double largest_force = 0.0;
   for (std::size_t k = 0; k < result.runs.size(); ++k) {
     largest_force = std::max(largest_force, worse(result.metrics[k].peak_force));
   }
-  out << "Actuator forces: largest " << fixed(largest_force, 0) << " N of the " << fixed(force_limit, 0)
-      << " N limit (" << (largest_force <= force_limit ? "within" : "EXCEEDED") << ").\n";
+  out << "Actuator forces: largest " << fixed(largest_force, 0) << " N of the " << fixed(s.force_limit, 0)
+      << " N limit (" << (largest_force <= s.force_limit ? "within" : "EXCEEDED") << ").\n";
   bool lost = false;
   for (std::size_t k = 0; k < result.runs.size(); ++k) {
     const auto& m = result.metrics[k];
@@ -452,74 +488,123 @@ CompareResult run_compare(const CompareOptions& options, std::ostream& out) {
           << fixed(m.time_without_contact[1], 3) << " s without contact.\n";
     }
   }
-  if (!lost) {
-    out << "Tyre contact: kept by both wheels in every run (least tyre load";
-    for (std::size_t k = 0; k < result.runs.size(); ++k) {
-      out << (k ? "; " : " ") << types[k] << " " << fixed(result.runs[k].least_tyre_load[0], 0) << "/"
-          << fixed(result.runs[k].least_tyre_load[1], 0) << " N";
-    }
-    out << ").\n";
-  }
-  explain(result, p, force_limit, config.controller.suspension.fuzzy, out);
-
-  // The JSON.
-  result.json_path = (fs::path(result.out_dir) / "metrics.json").string();
-  std::ofstream js(result.json_path);
-  if (!js) throw std::runtime_error(result.json_path + ": cannot create");
-  js << "{\n  \"rig\": \"half_car\",\n  \"config\": " << json_string(options.config_path)
-     << ",\n  \"case\": " << json_string(options.case_name) << ",\n  \"road\": " << json_string(describe_road(p))
-     << ",\n  \"plane\": \"" << (p.plane == HalfCarPlane::kPitch ? "pitch" : "roll") << "\""
-     << ",\n  \"duration_s\": " << json_number(duration) << ",\n  \"force_limit_n\": " << json_number(force_limit)
-     << ",\n  \"settling_band_m\": " << json_number(result.settling_band) << ",\n  \"runs\": {\n";
+  if (lost) return;
+  out << "Tyre contact: kept by both wheels in every run (least tyre load";
   for (std::size_t k = 0; k < result.runs.size(); ++k) {
-    const auto& m = result.metrics[k];
-    const auto& rec = result.runs[k];
-    auto pair = [](const std::array<double, 2>& a) { return "[" + json_number(a[0]) + ", " + json_number(a[1]) + "]"; };
-    js << "    " << json_string(types[k]) << ": {\n"
-       << "      \"csv\": " << json_string(fs::path(result.csv_paths[k]).filename().string()) << ",\n"
-       << "      \"final_state\": " << json_string(std::string(to_string(rec.loop.final_state))) << ",\n"
-       << "      \"ticks\": " << rec.loop.ticks << ",\n"
-       << "      \"peak_z_s_m\": " << json_number(m.peak_z_s) << ",\n"
-       << "      \"rms_z_s_m\": " << json_number(m.rms_z_s) << ",\n"
-       << "      \"peak_acc_m_s2\": " << json_number(m.peak_acc) << ",\n"
-       << "      \"rms_acc_m_s2\": " << json_number(m.rms_acc) << ",\n"
-       << "      \"wk_rms_acc_m_s2\": " << json_number(m.wk_rms_acc) << ",\n"
-       << "      \"settling_time_s\": " << json_number(m.settling_time) << ",\n"
-       << "      \"settled\": " << (m.settled ? "true" : "false") << ",\n"
-       << "      \"peak_jerk_m_s3\": " << json_number(m.peak_jerk) << ",\n"
-       << "      \"rms_jerk_m_s3\": " << json_number(m.rms_jerk) << ",\n"
-       << "      \"peak_travel_m\": " << pair(m.peak_travel) << ",\n"
-       << "      \"peak_tyre_deflection_m\": " << pair(m.peak_tyre_deflection) << ",\n"
-       << "      \"peak_force_n\": " << pair(m.peak_force) << ",\n"
-       << "      \"peak_applied_force_n\": " << pair(rec.peak_applied_force) << ",\n"
-       << "      \"time_without_contact_s\": " << pair(m.time_without_contact) << ",\n"
-       << "      \"least_tyre_load_n\": " << pair(rec.least_tyre_load) << ",\n"
-       << "      \"peak_phi_rad\": " << json_number(m.peak_phi) << ",\n"
-       << "      \"peak_phi_ddot_rad_s2\": " << json_number(m.peak_phi_ddot) << ",\n"
-       << "      \"rms_phi_ddot_rad_s2\": " << json_number(m.rms_phi_ddot) << "\n"
-       << "    }" << (k + 1 < result.runs.size() ? "," : "") << "\n";
+    out << (k ? "; " : " ") << types[k] << " " << fixed(result.runs[k].least_tyre_load[0], 0) << "/"
+        << fixed(result.runs[k].least_tyre_load[1], 0) << " N";
   }
-  js << "  },\n  \"reductions_percent\": {\n";
+  out << ").\n";
+}
+
+std::string json_pair(const std::array<double, 2>& a) {
+  return "[" + json_number(a[0]) + ", " + json_number(a[1]) + "]";
+}
+
+// One run's entry of metrics.json (without the separator after it).
+void write_run_json(std::ostream& js, const std::string& type, const std::string& csv_path,
+                    const SuspensionRecording& rec, const SuspensionMetrics& m) {
+  const std::pair<const char*, std::string> fields[] = {
+      {"csv", json_string(fs::path(csv_path).filename().string())},
+      {"final_state", json_string(std::string(to_string(rec.loop.final_state)))},
+      {"ticks", std::to_string(rec.loop.ticks)},
+      {"peak_z_s_m", json_number(m.peak_z_s)},
+      {"rms_z_s_m", json_number(m.rms_z_s)},
+      {"peak_acc_m_s2", json_number(m.peak_acc)},
+      {"rms_acc_m_s2", json_number(m.rms_acc)},
+      {"wk_rms_acc_m_s2", json_number(m.wk_rms_acc)},
+      {"settling_time_s", json_number(m.settling_time)},
+      {"settled", m.settled ? "true" : "false"},
+      {"peak_jerk_m_s3", json_number(m.peak_jerk)},
+      {"rms_jerk_m_s3", json_number(m.rms_jerk)},
+      {"peak_travel_m", json_pair(m.peak_travel)},
+      {"peak_tyre_deflection_m", json_pair(m.peak_tyre_deflection)},
+      {"peak_force_n", json_pair(m.peak_force)},
+      {"peak_applied_force_n", json_pair(rec.peak_applied_force)},
+      {"time_without_contact_s", json_pair(m.time_without_contact)},
+      {"least_tyre_load_n", json_pair(rec.least_tyre_load)},
+      {"peak_phi_rad", json_number(m.peak_phi)},
+      {"peak_phi_ddot_rad_s2", json_number(m.peak_phi_ddot)},
+      {"rms_phi_ddot_rad_s2", json_number(m.rms_phi_ddot)},
+  };
+  js << "    " << json_string(type) << ": {\n";
+  const std::size_t n = std::size(fields);
+  for (std::size_t i = 0; i < n; ++i) {
+    js << "      \"" << fields[i].first << "\": " << fields[i].second << (i + 1 < n ? ",\n" : "\n");
+  }
+  js << "    }";
+}
+
+void write_reductions_json(std::ostream& js, const CompareResult& result) {
+  const auto& types = suspension_controller_types();
+  const auto& rows = reduction_rows();
   for (std::size_t k = 1; k < types.size(); ++k) {
     js << "    " << json_string(types[k]) << ": {";
-    const auto& rows = reduction_rows();
     for (std::size_t i = 0; i < rows.size(); ++i) {
       js << (i ? ", " : "") << json_string(rows[i].key) << ": "
          << json_number(row_reduction(rows[i], result.metrics[0], result.metrics[k]));
     }
     js << "}" << (k + 1 < types.size() ? "," : "") << "\n";
   }
-  js << "  },\n  \"paper\": {\"peak_body_displacement_reduction_percent\": "
-     << json_number(paper.peak_body_displacement_reduction)
+}
+
+void write_paper_json(std::ostream& js) {
+  const PaperFigures paper;
+  js << "{\"peak_body_displacement_reduction_percent\": " << json_number(paper.peak_body_displacement_reduction)
      << ", \"peak_body_acceleration_reduction_percent\": " << json_number(paper.peak_body_acceleration_reduction)
      << ", \"peak_tyre_deflection_reduction_percent\": " << json_number(paper.peak_tyre_deflection_reduction)
      << ", \"settling_passive_s\": " << json_number(paper.settling_passive_s)
      << ", \"settling_active_s\": " << json_number(paper.settling_active_s)
      << ", \"roll_acceleration_reduction_percent\": " << json_number(paper.roll_acceleration_reduction)
      << ", \"lqr_wk_rms_passive_m_s2\": " << json_number(paper.lqr_wk_passive)
-     << ", \"lqr_wk_rms_active_m_s2\": " << json_number(paper.lqr_wk_active) << "}\n}\n";
+     << ", \"lqr_wk_rms_active_m_s2\": " << json_number(paper.lqr_wk_active) << "}";
+}
+
+void write_metrics_json(const CompareSetup& s, CompareResult& result) {
+  const HalfCarParams& p = s.car();
+  const auto& types = suspension_controller_types();
+  result.json_path = (fs::path(result.out_dir) / "metrics.json").string();
+  std::ofstream js(result.json_path);
+  if (!js) throw std::runtime_error(result.json_path + ": cannot create");
+  js << "{\n  \"rig\": \"half_car\",\n  \"config\": " << json_string(s.options.config_path)
+     << ",\n  \"case\": " << json_string(s.options.case_name) << ",\n  \"road\": " << json_string(describe_road(p))
+     << ",\n  \"plane\": \"" << (p.plane == HalfCarPlane::kPitch ? "pitch" : "roll") << "\""
+     << ",\n  \"duration_s\": " << json_number(s.duration) << ",\n  \"force_limit_n\": " << json_number(s.force_limit)
+     << ",\n  \"settling_band_m\": " << json_number(result.settling_band) << ",\n  \"runs\": {\n";
+  for (std::size_t k = 0; k < result.runs.size(); ++k) {
+    write_run_json(js, types[k], result.csv_paths[k], result.runs[k], result.metrics[k]);
+    js << (k + 1 < result.runs.size() ? "," : "") << "\n";
+  }
+  js << "  },\n  \"reductions_percent\": {\n";
+  write_reductions_json(js, result);
+  js << "  },\n  \"paper\": ";
+  write_paper_json(js);
+  js << "\n}\n";
   js.close();
   if (!js) throw std::runtime_error(result.json_path + ": write failed");
+}
+
+}  // namespace
+
+// The comparison's story: set up, run and measure, then report.
+CompareResult run_compare(const CompareOptions& options, std::ostream& out) {
+  const CompareSetup setup = load_compare_setup(options);
+  CompareResult result;
+  result.out_dir = compare_out_dir(setup);
+  fs::create_directories(result.out_dir);
+  print_compare_header(setup, out);
+
+  compute_compare(setup, result, [&out](ControllerKind controller, const SuspensionRecording& rec) {
+    out << "  " << std::left << std::setw(8) << controller << std::right << " " << rec.loop.ticks << " ticks, "
+        << to_string(rec.loop.final_state) << "\n";
+    out.flush();
+  });
+
+  write_compare_csvs(setup, result);
+  print_metrics(setup, result, out);
+  print_forces_and_contact(setup, result, out);
+  explain(result, setup.car(), setup.force_limit, setup.config.controller.suspension.fuzzy, out);
+  write_metrics_json(setup, result);
 
   out << "\n  csv: " << result.out_dir << "/{passive,fuzzy,skyhook,lqr}.csv\n  metrics: " << result.json_path << "\n";
   out.flush();

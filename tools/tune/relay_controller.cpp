@@ -45,15 +45,9 @@ void RelayController::update(double setpoint, const Sample& sample, Command& com
   ++tick_;
   const double output = std::clamp(u, -s_.output_limit, s_.output_limit);
   command.value[static_cast<std::size_t>(s_.output_index)] = output;
-  terms.setpoint = setpoint;
-  terms.measurement = y;
-  terms.error = e;
   terms.term[1] = hold_;
   terms.term[2] = d_;
-  terms.output_unsaturated = u;
-  terms.output = output;
-  terms.saturated = u != output;
-  terms.integrator_held = false;
+  fill_terms(terms, {.setpoint = setpoint, .measurement = y, .unsaturated = u, .output = output, .saturated = u != output});
 }
 
 }  // namespace rigctl
