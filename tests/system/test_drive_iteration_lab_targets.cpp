@@ -68,7 +68,7 @@ struct LabTarget {
     }
   }
 
-  double road(double t) const {
+  double road(double t, double k) const {
     if (t <= road_from || t >= road_to) return 0.0;
     const double fade = std::min({1.0, t - road_from, road_to - t});  // 1 s in and out
     double x = 0.0;
@@ -77,27 +77,37 @@ struct LabTarget {
     for (double b : bumps_at) {
       if (t >= b && t <= b + bump_length) bumps += bump_height * 0.5 * (1 - std::cos(2 * std::numbers::pi * (t - b) / bump_length));
     }
-    return scale * fade * fade * x + bumps;
+    return k * fade * fade * x + bumps;
   }
 
-  double at(double t) const {
+  double at(double t) const { return at_scale(t, scale); }
+
+  // With the random content scaled by k.
+  double at_scale(double t, double k) const {
     const double lead = t < 12.0 ? half_cosine_ramp(t, 1.0, 3.5, home, mid) : half_cosine_ramp(t, 20.5, 2.5, mid, home);
-    return lead + road(t);
+    return lead + road(t, k);
   }
 
-  double peak_velocity(double dt) const {
-    double peak = 0.0;
-    for (double t = dt; t < duration; t += dt) peak = std::max(peak, std::abs(at(t) - at(t - dt)) / dt);
-    return peak;
-  }
-
-  // The random content scaled (bisection) so the whole target's peak velocity is v.
+  // The random content scaled (bisection) so the whole target's peak
+  // velocity, sampled every millisecond, is v.
   void set_peak_velocity(double v) {
-    double lo = 0.0, hi = 1.0;
-    for (int i = 0; i < 50; ++i) {
-      scale = 0.5 * (lo + hi);
-      (peak_velocity(1e-3) > v ? hi : lo) = scale;
+    const double dt = 1e-3;
+    std::vector<double> rest, random;
+    for (double t = 0.0; t < duration; t += dt) {
+      const double bumps_and_lead = at_scale(t, 0.0);
+      rest.push_back(bumps_and_lead);
+      random.push_back(at_scale(t, 1.0) - bumps_and_lead);
     }
+    const auto peak = [&](double k) {
+      double p = 0.0;
+      for (std::size_t i = 1; i < rest.size(); ++i) {
+        p = std::max(p, std::abs(rest[i] - rest[i - 1] + k * (random[i] - random[i - 1])) / dt);
+      }
+      return p;
+    };
+    double lo = 0.0, hi = 1.0;
+    for (int i = 0; i < 50; ++i) (peak(0.5 * (lo + hi)) > v ? hi : lo) = 0.5 * (lo + hi);
+    scale = 0.5 * (lo + hi);
   }
 };
 
@@ -123,6 +133,12 @@ struct RpcChannel {
   std::vector<double> values;
 };
 
+std::string scientific(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.9e", v);
+  return b;
+}
+
 std::string rpc_record(const std::string& key, const std::string& value) {
   std::string r(128, '\0');
   std::memcpy(r.data(), key.data(), key.size());
@@ -135,7 +151,7 @@ std::string rpc3_bytes(const std::vector<RpcChannel>& channels, double dt, bool 
   const std::size_t per_frame = 512, per_group = 2048, n = channels.front().values.size();
   const std::size_t frames = (n + per_frame - 1) / per_frame;
   std::vector<std::pair<std::string, std::string>> rec{
-      {"FILE_TYPE", "TIME_HISTORY"}, {"TIME_TYPE", "RESPONSE"}, {"DELTA_T", std::to_string(dt)},
+      {"FILE_TYPE", "TIME_HISTORY"}, {"TIME_TYPE", "RESPONSE"}, {"DELTA_T", scientific(dt)},
       {"CHANNELS", std::to_string(channels.size())}, {"DATA_TYPE", integers ? "SHORT_INTEGER" : "FLOATING_POINT"},
       {"PTS_PER_FRAME", std::to_string(per_frame)}, {"PTS_PER_GROUP", std::to_string(per_group)},
       {"FRAMES", std::to_string(frames)}, {"PARTITIONS", "1"}};
@@ -147,7 +163,7 @@ std::string rpc3_bytes(const std::vector<RpcChannel>& channels, double dt, bool 
     const std::string k = std::to_string(c + 1);
     rec.push_back({"DESC.CHAN_" + k, channels[c].name});
     rec.push_back({"UNITS.CHAN_" + k, channels[c].unit});
-    rec.push_back({"SCALE.CHAN_" + k, std::to_string(integers ? scale.back() : 1.0)});
+    rec.push_back({"SCALE.CHAN_" + k, scientific(integers ? scale.back() : 1.0)});
   }
   for (const auto& [k, v] : overrides) {
     for (auto& r : rec) {

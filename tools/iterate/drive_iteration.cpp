@@ -52,6 +52,7 @@ struct Step {
   const IterationRig& rig;
   const IterationSettings& settings;
   std::vector<double> weight;
+  ValveLaw law;
 
   double dt() const { return rig.config->loop.period_s; }
 
@@ -92,7 +93,7 @@ struct Step {
 
   DrivePeaks peaks(const std::vector<double>& drive, const PredictionCorrection& k) const {
     return drive_peaks(drive, rig.operating_point, dt(),
-                       predict_motion(rig.paths, drive, dt(), rig.command_hold, k));
+                       predict_motion(rig.paths, drive, dt(), rig.command_hold, law, k));
   }
 
   bool admit(std::vector<double>& drive, IterationRecord& rec, IterationOutcome& out) const;
@@ -168,7 +169,8 @@ IterationOutcome iterate_drive(const std::vector<double>& target, const Iteratio
   IterationOutcome out;
   out.window = test_window_of(target, dt, s);
   const DriveInverse inverse(rig.channel, target.size(), dt, s.inverse);
-  const Step step{inverse, rig, s, correction_weight(out.window, target, dt, s.lead_s, s.fade_s)};
+  const Step step{inverse, rig, s, correction_weight(out.window, target, dt, s.lead_s, s.fade_s),
+                  valve_law(*rig.config, rig.command_hold)};
   if (!admit_full_level(step, target, out)) return out;
   std::vector<double> gain(inverse.bands().size(), s.initial_gain);
   std::vector<double> drive = step.first_drive(target, s.first_level);

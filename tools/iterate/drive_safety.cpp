@@ -23,6 +23,11 @@ constexpr double kEffortShare = 0.8;
 // prediction of a slow swing is good to a fraction of a millimetre, and the
 // loop's tracking of the largest swing adds a few.
 constexpr double kStrokeMargin = 0.03;
+// The drive may pass the setpoint range by 10^-4 of its width (16 um on the
+// quarter car, below its LVDT's 20 um noise): a target that holds at home,
+// the range's bottom, and was resampled or quantised in a file comes back
+// a fraction of a micrometre below it, and the drive follows the target there.
+constexpr double kPositionTolerance = 1e-4;
 
 std::string fmt(double v) {
   char b[32];
@@ -92,14 +97,16 @@ DriveVerdict check_drive(const DrivePeaks& k, const DriveLimits& l, double op) {
       v.reason = why;
     }
   };
-  auto range = [&](double low, double high, double limit_low, double limit_high, const std::string& what,
+  // slack: how far past the limit still counts as within it.
+  auto range = [&](double low, double high, double limit_low, double limit_high, double slack, const std::string& what,
                    const std::string& source) {
-    if (high > op) take((limit_high - op) / (high - op), "stroke: " + what + fmt(high) + ", above " + source + " max " + fmt(limit_high));
-    if (low < op) take((op - limit_low) / (op - low), "stroke: " + what + fmt(low) + ", below " + source + " min " + fmt(limit_low));
+    if (high > op) take((limit_high + slack - op) / (high - op), "stroke: " + what + fmt(high) + ", above " + source + " max " + fmt(limit_high));
+    if (low < op) take((op - limit_low + slack) / (op - low), "stroke: " + what + fmt(low) + ", below " + source + " min " + fmt(limit_low));
   };
-  range(k.min, k.max, l.position_min, l.position_max, "the drive reaches ", l.position_source);
+  range(k.min, k.max, l.position_min, l.position_max, kPositionTolerance * (l.position_max - l.position_min),
+        "the drive reaches ", l.position_source);
   const PredictedMotion& p = k.predicted;
-  range(p.rod_min, p.rod_max, l.stroke_min, l.stroke_max, "the rod is predicted to reach ", l.stroke_source);
+  range(p.rod_min, p.rod_max, l.stroke_min, l.stroke_max, 0.0, "the rod is predicted to reach ", l.stroke_source);
   if (p.rod_velocity > 0.0) {
     take(l.velocity_max / p.rod_velocity, "velocity: the rod is predicted to move at " + fmt(p.rod_velocity) +
                                                " beyond " + l.velocity_source + " " + fmt(l.velocity_max));

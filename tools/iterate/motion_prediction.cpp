@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "tools/iterate/spectrum.hpp"
 
@@ -24,8 +25,28 @@ double peak_rate(const std::vector<double>& x, double dt) {
 
 }  // namespace
 
+ValveLaw valve_law(const RigConfig& c, double command_hold) {
+  if (c.rig != RigKind::kQuarterCar) return {};
+  const QuarterCarParams& p = c.quarter_car;
+  // Flow continuity through the supply edge and the return edge at velocity v,
+  // Q_in = Kv u sqrt(Ps - p_in), Q_out = Kv u sqrt(p_out), with the force
+  // balance A1 p1 - A2 p2 = F (the static load of rod, wheel and body):
+  // extending (v > 0) gives (v / Kv u)^2 = (A1 Ps - F) / (A1^3 + A2^3),
+  // retracting (F + A2 Ps) / (A1^3 + A2^3). The inertia forces are left out
+  // (small beside the supply's 40 kN); the measured ratio takes up the rest.
+  const double weight = (p.mass_rod + p.mass_wheel + p.mass_body) * p.gravity;
+  const double cubes = std::pow(p.area_cap, 3) + std::pow(p.area_rod, 3);
+  const double out_force = p.area_cap * p.supply_pressure - weight, in_force = p.area_rod * p.supply_pressure + weight;
+  const double out_speed = out_force > 0.0 ? p.valve_flow_gain * std::sqrt(out_force / cubes) : 0.0;
+  const double in_speed = p.valve_flow_gain * std::sqrt(in_force / cubes);
+  return [=](double v) {
+    const double speed = v >= 0.0 ? out_speed : in_speed;  // [m/s] per unit command
+    return speed > 0.0 ? command_hold + v / speed : std::numeric_limits<double>::infinity();
+  };
+}
+
 PredictedMotion predict_motion(const LoopPaths& paths, const std::vector<double>& drive, double dt,
-                               double command_hold, const PredictionCorrection& k) {
+                               double command_hold, const ValveLaw& law, const PredictionCorrection& k) {
   PredictedMotion m;
   if (drive.empty()) return m;
   // The rod: the closed loop's T from the drive, 1 at rest (the loop's integral).
@@ -34,6 +55,13 @@ PredictedMotion predict_motion(const LoopPaths& paths, const std::vector<double>
   m.rod_min = *lo;
   m.rod_max = *hi;
   m.rod_velocity = k.velocity * peak_rate(rod, dt);
+  if (law) {
+    for (std::size_t i = 1; i + 1 < rod.size(); ++i) {
+      m.valve_effort = std::max(m.valve_effort, std::abs(law((rod[i + 1] - rod[i - 1]) / (2.0 * dt))));
+    }
+    m.valve_effort *= k.effort;
+    return m;
+  }
   // The command's deviation from its hold: T / G, which falls to 0 at rest
   // (a held position needs only the hold); below the first line it falls
   // with the frequency as a velocity's command does.

@@ -13,8 +13,10 @@
 // rig itself.
 #pragma once
 
+#include <functional>
 #include <vector>
 
+#include "config/rig_config.hpp"
 #include "tools/iterate/drive_frf.hpp"
 
 namespace rigctl {
@@ -37,9 +39,19 @@ struct PredictionCorrection {
   double effort = 1.0;
 };
 
+// The valve command a rod velocity needs, the hold included: the rig's
+// large-signal valve law where the rig has one (the quarter car's orifice
+// law through both metering edges of its asymmetric cylinder); empty for
+// the others, whose command is predicted through the loop's FRF to it.
+using ValveLaw = std::function<double(double velocity)>;
+ValveLaw valve_law(const RigConfig& config, double command_hold);
+
 // command_hold: the command that holds the rig at rest (the leakage's).
+// The command: the valve law at the predicted rod's velocity where there is
+// one (the linearised FRF to the command cannot tell extending from
+// retracting, 30 % apart on the quarter car), else the FRF's.
 PredictedMotion predict_motion(const LoopPaths& paths, const std::vector<double>& drive, double dt,
-                               double command_hold, const PredictionCorrection& correction);
+                               double command_hold, const ValveLaw& law, const PredictionCorrection& correction);
 
 // feedback and command as recorded over the drive's ticks.
 MeasuredMotion measured_motion(const std::vector<double>& feedback, const std::vector<double>& command, double dt,

@@ -31,9 +31,10 @@ struct Rig {
   RigConfig config = quarter_car();
   LoopPaths paths = loop_paths_from_model(config, 0.08, model_frequencies(0.05, 40.0), "nominal model");
   double hold = linearise_quarter_car(config.quarter_car, 0.08, {"x_r"}).command;
+  ValveLaw law = valve_law(config, hold);
 
   DrivePeaks peaks(const std::vector<double>& d, const PredictionCorrection& k = {}) const {
-    return drive_peaks(d, 0.08, config.loop.period_s, predict_motion(paths, d, config.loop.period_s, hold, k));
+    return drive_peaks(d, 0.08, config.loop.period_s, predict_motion(paths, d, config.loop.period_s, hold, law, k));
   }
 };
 
@@ -63,11 +64,29 @@ TEST(DriveSafety, ThePredictionFollowsTheClosedLoop) {
   EXPECT_LT(t, 0.9);
   EXPECT_NEAR(k.predicted.rod_velocity, t * a * w, 0.03 * t * a * w);
   EXPECT_NEAR(k.predicted.rod_max - 0.08, t * a, 0.03 * t * a);
-  EXPECT_NEAR(k.predicted.valve_effort, std::abs(r.hold) + u * a, 0.03 * (std::abs(r.hold) + u * a));
+  // The command by the orifice law at the rod's peak velocity, retracting (the weaker edge) ...
+  const double v = t * a * w;
+  EXPECT_NEAR(k.predicted.valve_effort, std::abs(r.law(-v)), 0.03 * std::abs(r.law(-v)));
+  EXPECT_GT(std::abs(r.law(-v)), std::abs(r.law(v)));
+  // ... and without a law, through the loop's FRF to the command.
+  const PredictedMotion linear = predict_motion(r.paths, sine(0.08, a, f, r.config.loop.period_s, 6.0), r.config.loop.period_s, r.hold, {}, {});
+  EXPECT_NEAR(linear.valve_effort, std::abs(r.hold) + u * a, 0.03 * (std::abs(r.hold) + u * a));
   // A measured ratio scales the next prediction.
   const DrivePeaks corrected = r.peaks(sine(0.08, a, f, r.config.loop.period_s, 6.0), PredictionCorrection{1.5, 1.25});
   EXPECT_NEAR(corrected.predicted.rod_velocity, 1.5 * k.predicted.rod_velocity, 1e-12);
   EXPECT_NEAR(corrected.predicted.valve_effort, 1.25 * k.predicted.valve_effort, 1e-12);
+}
+
+TEST(DriveSafety, TheValveLawFollowsTheOrificeBothWays) {
+  const Rig r;
+  const ValveLaw law = valve_law(r.config, 0.0);
+  // Retracting pushes on the small rod-side area against the load: more
+  // effort for the same speed than extending.
+  EXPECT_GT(std::abs(law(-0.1)), law(0.1));
+  EXPECT_NEAR(law(0.2), 2 * law(0.1), 1e-12);
+  EXPECT_NEAR(law(0.1), 0.1 / 0.372, 0.01);  // Kv sqrt((A1 Ps - W) / (A1^3 + A2^3)) = 0.372 m/s per unit command
+  EXPECT_NEAR(std::abs(law(-0.1)), 0.1 / 0.286, 0.01);
+  EXPECT_NEAR(valve_law(r.config, -0.043)(0.0), -0.043, 1e-12);
 }
 
 TEST(DriveSafety, AReachableDrivePasses) {
