@@ -308,6 +308,28 @@ TEST(LabTargets, RpcThreeMultiChannelAt512HzIsReadResampledAndIterated) {
   expect_prediction_held(s, 0.2);
 }
 
+// The same kind of file with 32-bit floating-point data, the channel chosen
+// by its name: one half-level pass, its error that level's (about 50 %).
+TEST(LabTargets, RpcThreeFloatingPointIsReadByChannelName) {
+  const std::string dir = fresh_dir("rpcfloat");
+  LabTarget target(35);
+  target.set_peak_velocity(0.12);
+  const double dt = 1.0 / 512;
+  const std::vector<RpcChannel> channels{
+      {"wheel_z", "m", sampled([&](double t) { return target.at(t); }, dt, target.duration)},
+      {"body_z", "m", sampled([&](double t) { return 0.5 * target.at(t); }, dt, target.duration)}};
+  write_file(dir + "/road.tim", rpc3_bytes(channels, dt, false));
+  const auto r = rigctl("iterate " + kConfig + " --target " + dir + "/road.tim --target-channel wheel_z --channel x_w --out " +
+                        dir + "/out --fast --no-realtime --max-iterations 1");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto s = summary_of(dir + "/out");
+  EXPECT_EQ(s["target_channel"], "wheel_z");
+  EXPECT_NEAR(s["operating_point"].get<double>(), target.mid, 0.002);  // the wheel's, not the body's 40 mm
+  ASSERT_EQ(s["iterations"].size(), 1u) << r.output;
+  EXPECT_NEAR(s["iterations"][0]["rel_rms_percent"].get<double>(), 50.0, 10.0) << r.output;
+  expect_prediction_held(s, 0.2);
+}
+
 // A run file sampled at 1 kHz whose time starts at 3 s: resampled, iterated.
 TEST(LabTargets, ARunFileAt1kHzStartingAt3sIsResampledAndIterated) {
   const std::string dir = fresh_dir("csv1k");
