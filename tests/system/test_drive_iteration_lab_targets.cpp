@@ -330,16 +330,20 @@ TEST(LabTargets, RpcThreeFloatingPointIsReadByChannelName) {
   expect_prediction_held(s, 0.2);
 }
 
-// A run file sampled at 1 kHz whose time starts at 3 s: resampled, iterated.
+// A run file sampled at 1 kHz whose time starts at 3 s: resampled, iterated,
+// the error judged over the part --window sets (times from the record's start).
 TEST(LabTargets, ARunFileAt1kHzStartingAt3sIsResampledAndIterated) {
   const std::string dir = fresh_dir("csv1k");
   LabTarget target(33);
   target.set_peak_velocity(0.12);
   write_csv(dir + "/target.csv", target, 0.001, 3.0, "x_w");
   const auto r = rigctl("iterate " + kConfig + " --target " + dir + "/target.csv --channel x_w --out " + dir +
-                        "/out --fast --no-realtime --max-iterations 2");
+                        "/out --fast --no-realtime --max-iterations 2 --window 6:18");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto s = summary_of(dir + "/out");
+  EXPECT_EQ(s["window_source"], "--window");
+  EXPECT_NEAR(s["window_s"][0].get<double>(), 6.0, 1e-9);
+  EXPECT_NEAR(s["window_s"][1].get<double>(), 18.0, 1e-9);
   EXPECT_NEAR(s["target_period_s"].get<double>(), 0.001, 1e-9);
   EXPECT_NEAR(s["target_start_s"].get<double>(), 3.0, 1e-9);
   ASSERT_EQ(s["iterations"].size(), 2u) << r.output;
@@ -376,6 +380,14 @@ TEST(LabTargets, MalformedOrTooLongTargetsAreRefusedNamingWhy) {
     EXPECT_FALSE(std::filesystem::exists(dir + "/out/iter_01_run.csv"));
   }
   write_csv(dir + "/long.csv", target, 0.0025, 0.0, "x_w");
+  const auto bad_window = rigctl("iterate " + kConfig + " --target " + dir + "/long.csv --channel x_w --window 5-20 --out " +
+                                 dir + "/out --fast --no-realtime");
+  EXPECT_EQ(bad_window.exit_code, 1) << bad_window.output;
+  EXPECT_NE(bad_window.output.find("--window '5-20': expected T0:T1 in seconds"), std::string::npos) << bad_window.output;
+  const auto outside = rigctl("iterate " + kConfig + " --target " + dir + "/long.csv --channel x_w --window 5:40 --out " +
+                              dir + "/out --fast --no-realtime");
+  EXPECT_EQ(outside.exit_code, 1) << outside.output;
+  EXPECT_NE(outside.output.find("needs 0 <= T0 < T1 <= 23"), std::string::npos) << outside.output;
   const auto r = rigctl("iterate " + kConfig + " --target " + dir + "/long.csv --channel x_w --max-length 20 --out " + dir +
                         "/out --fast --no-realtime");
   EXPECT_EQ(r.exit_code, 1) << r.output;
