@@ -234,7 +234,13 @@ int main(int argc, char** argv) {
   iter_cmd->add_option("config", iter.config_path, "Rig config (YAML)")->required()->check(CLI::ExistingFile);
   iter_cmd->add_option("--case", iter.case_name, "Apply a named variant from the config's `cases:`");
   iter_cmd->add_option("--target", iter.target_path, "Target: a run file (t and the channel) or an RPC III file (.rsp, .tim)")->required()->check(CLI::ExistingFile);
-  iter_cmd->add_option("--channel", iter.channel, "The target channel, e.g. x_w")->required();
+  iter_cmd->add_option("--channel", iter.channel, "The rig's channel the target is for, e.g. x_w")->required();
+  iter_cmd->add_option("--target-channel", iter.target_channel, "The target file's channel: a name or a 1-based number (default: --channel)");
+  iter_cmd->add_option("--max-length", iter.max_length_s, "Longest target played [s]; a longer one is refused")->capture_default_str()->check(CLI::PositiveNumber);
+  std::string iter_window;
+  iter_cmd->add_option("--window", iter_window, "T0:T1, the part of the target the error is judged on [s] (default: where it departs from its lead-in and lead-out)");
+  iter_cmd->add_option("--first-level", iter.settings.first_level, "The first drive's level in the band, a share of the inverse's")->capture_default_str()->check(CLI::Range(0.05, 1.0));
+  iter_cmd->add_option("--max-growth", iter.settings.max_growth, "Refuse a drive whose content in the band grew more than this over the last one")->capture_default_str()->check(CLI::Range(1.0, 100.0));
   iter_cmd->add_option("--out", iter.out_dir, "Folder for summary.json and each iteration's drive and response")->required();
   auto* frf_opt = iter_cmd->add_option("--frf", iter.frf_path, "FRF file from rigctl identify (with the channel: identify --response NAME)")->check(CLI::ExistingFile);
   iter_cmd->add_option("--model", iter.model_path, "Diagnosis JSON (rigctl diagnose --json): the inverse from the model it extended (default: the config's nominal model)")->check(CLI::ExistingFile)->excludes(frf_opt);
@@ -289,6 +295,7 @@ int main(int argc, char** argv) {
     }
     if (iter_cmd->parsed()) {
       iter.effects = parse_effects(iter_effects);
+      if (!iter_window.empty()) iter.settings.window_s = rigctl::parse_time_window(iter_window);
       install_stop_handlers();
       const auto result = rigctl::run_iterate(iter, g_stop, std::cout);
       return result.outcome.end == rigctl::IterationEnd::kRunEnded ? 3 : 0;

@@ -76,8 +76,16 @@ void expect_converged_within_six(const nlohmann::json& s, const std::string& out
   for (const auto& i : it) {
     EXPECT_GT(i["peak_error"].get<double>(), 0.0);
     EXPECT_GT(i["drive"]["peak_velocity"].get<double>(), 0.0);
-    EXPECT_GT(i["drive"]["peak_valve_effort"].get<double>(), 0.0);
-    EXPECT_LE(i["drive"]["peak_valve_effort"].get<double>(), 0.8);
+    EXPECT_GT(i["predicted"]["valve_effort"].get<double>(), 0.0);
+    EXPECT_LE(i["predicted"]["valve_effort"].get<double>(), 0.8);
+    EXPECT_LE(i["measured"]["valve_effort"].get<double>(), 0.8);
+    // The rod's velocity is predicted to 20 %; the valve's effort too once
+    // one drive was measured: the first, at half level, meets the worn
+    // seal's leak that the nominal model lacks (it needed 1.5 times the
+    // predicted command), and its ratio corrects the next prediction
+    // (docs/drive-iteration.md 3).
+    EXPECT_NEAR(i["measured"]["rod_velocity_ratio"].get<double>(), 1.0, 0.2) << i;
+    if (i["iteration"] != 1) EXPECT_NEAR(i["measured"]["valve_effort_ratio"].get<double>(), 1.0, 0.2) << i;
     EXPECT_EQ(i["drive"]["scale"].get<double>(), 1.0);
   }
 }
@@ -215,7 +223,8 @@ TEST(DriveIteration, BeyondTheStrokeEndsAtTheStrokeLimitWithoutPlaying) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto s = summary_of(dir + "/out");
   EXPECT_EQ(s["end"], "drive_limit");
-  EXPECT_NE(s["end_detail"].get<std::string>().find("drive 1 not played: stroke: "), std::string::npos) << s["end_detail"];
+  EXPECT_NE(s["end_detail"].get<std::string>().find("drive 1 not played: the target's drive at full level: stroke: "),
+            std::string::npos) << s["end_detail"];
   EXPECT_TRUE(s["iterations"].empty());
   EXPECT_FALSE(std::filesystem::exists(dir + "/out/iter_01_run.csv"));  // nothing moved
 }
@@ -229,7 +238,9 @@ TEST(DriveIteration, BeyondTheValvesFlowEndsAtTheFlowLimitWithoutATrip) {
   ASSERT_EQ(refused.exit_code, 0) << refused.output;
   const auto s = summary_of(dir + "/refused");
   EXPECT_EQ(s["end"], "drive_limit");
-  EXPECT_NE(s["end_detail"].get<std::string>().find("not played: flow: "), std::string::npos) << s["end_detail"];
+  EXPECT_NE(s["end_detail"].get<std::string>().find("drive 1 not played: the target's drive at full level: flow: "),
+            std::string::npos) << s["end_detail"];
+  EXPECT_FALSE(std::filesystem::exists(dir + "/refused/iter_01_run.csv"));  // nothing moved
 
   // Asked to scale, every drive is played scaled to the flow limit: each run
   // completes (a trip would end the iteration with run_ended and exit 3),
@@ -240,11 +251,12 @@ TEST(DriveIteration, BeyondTheValvesFlowEndsAtTheFlowLimitWithoutATrip) {
   const auto t = summary_of(dir + "/scaled");
   EXPECT_NE(t["end"], "run_ended");
   EXPECT_NE(t["end"], "tolerance");
-  ASSERT_FALSE(t["iterations"].empty());
+  ASSERT_GE(t["iterations"].size(), 2u);
   for (const auto& i : t["iterations"]) {
+    EXPECT_LE(i["predicted"]["valve_effort"].get<double>(), 0.8);
+    if (i["iteration"] == 1) continue;  // the half-level first pass may fit as it is
     EXPECT_LT(i["drive"]["scale"].get<double>(), 1.0);
     EXPECT_EQ(i["drive"]["limited_by"].get<std::string>().rfind("flow: ", 0), 0u) << i["drive"]["limited_by"];
-    EXPECT_LE(i["drive"]["peak_valve_effort"].get<double>(), 0.8);
   }
   EXPECT_NE(t["end_detail"].get<std::string>().find("flow: "), std::string::npos) << t["end_detail"];
 }

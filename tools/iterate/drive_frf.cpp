@@ -75,6 +75,31 @@ DriveFrf drive_frf_from_model(const RigConfig& config, const std::string& channe
   return d;
 }
 
+LoopPaths loop_paths_from_model(const RigConfig& config, double operating_point, const std::vector<double>& frequency_hz,
+                                const std::string& source) {
+  const std::string& feedback = config.controller.feedback;
+  LoopPaths p;
+  p.feedback = drive_frf_from_model(config, feedback, operating_point, frequency_hz, source);
+  const auto plant = sampled_frf(linearise_quarter_car(config.quarter_car, operating_point, {feedback}),
+                                 config.loop.period_s, frequency_hz);
+  p.command = p.feedback;
+  for (std::size_t i = 0; i < frequency_hz.size(); ++i) p.command.value[i] = p.feedback.value[i] / plant[0].value[i];
+  return p;
+}
+
+LoopPaths loop_paths_from_file(const FrfData& frf, const std::string& feedback, const std::string& name) {
+  LoopPaths p;
+  p.feedback = drive_frf_from_file(frf, feedback, name);
+  const FrfCurve* plant = nullptr;
+  for (const auto& c : frf.plant) {
+    if (c.response == feedback) plant = &c;
+  }
+  if (plant == nullptr) throw std::invalid_argument(name + ": no plant curve of '" + feedback + "' (command -> " + feedback + ")");
+  p.command = p.feedback;
+  for (std::size_t i = 0; i < p.command.value.size(); ++i) p.command.value[i] = p.feedback.value[i] / plant->value[i];
+  return p;
+}
+
 std::vector<double> model_frequencies(double step_hz, double high_hz) {
   std::vector<double> f;
   for (double x = step_hz; x <= high_hz + 1e-9; x += step_hz) f.push_back(x);

@@ -39,6 +39,21 @@ DriveFrf drive_frf_from_file(const FrfData& frf, const std::string& channel, con
 DriveFrf drive_frf_from_model(const RigConfig& config, const std::string& channel, double operating_point,
                               const std::vector<double>& frequency_hz, const std::string& source);
 
+// Where the rig's own limits are met: the drive's paths through the closed
+// loop to the controlled position (the rod: stroke and rate detector) and
+// to the valve command (the output limit; its deviation from the hold). The
+// same FRF source as the inverse's: a model's T = L / (1 + L) and T / G, or
+// a measured file's closed-loop curve of the feedback and that over its
+// plant curve (demand -> command = T / G).
+struct LoopPaths {
+  DriveFrf feedback;  // drive -> controller.feedback
+  DriveFrf command;   // drive -> controller.output
+};
+LoopPaths loop_paths_from_model(const RigConfig& config, double operating_point, const std::vector<double>& frequency_hz,
+                                const std::string& source);
+// Throws std::invalid_argument when the file lacks the feedback's curves.
+LoopPaths loop_paths_from_file(const FrfData& frf, const std::string& feedback, const std::string& name);
+
 // The model's frequencies: every `step_hz` from step_hz to high_hz.
 std::vector<double> model_frequencies(double step_hz, double high_hz);
 

@@ -45,9 +45,17 @@ DriveInverse::DriveInverse(const DriveFrf& frf, std::size_t samples, double peri
   }
 }
 
+// The record continued smoothly from its end back to its start (no step for
+// the FFT's periodic view to see: a target from home to mid-stroke would
+// otherwise put a spike at both ends of the drive).
+std::vector<double> DriveInverse::padded_record(const std::vector<double>& x) const {
+  std::vector<double> head(x.begin(), x.begin() + static_cast<std::ptrdiff_t>(std::min(x.size(), samples_)));
+  head.resize(samples_, head.empty() ? 0.0 : head.back());
+  return smoothly_padded(head, padded_ - samples_);
+}
+
 std::vector<double> DriveInverse::apply(const std::vector<double>& x, const std::vector<double>& gain) const {
-  std::vector<double> padded(padded_, 0.0);
-  std::copy_n(x.begin(), std::min(x.size(), samples_), padded.begin());
+  const std::vector<double> padded = padded_record(x);
   Spectrum s = forward_fft(padded);
   for (std::size_t k = 0; k < padded_; ++k) s[k] *= band_[k] < gain.size() ? gain[band_[k]] * inverse_[k] : 0.0;
   std::vector<double> out = inverse_fft(s);
@@ -56,14 +64,27 @@ std::vector<double> DriveInverse::apply(const std::vector<double>& x, const std:
 }
 
 std::vector<double> DriveInverse::band_energy(const std::vector<double>& x) const {
-  std::vector<double> padded(padded_, 0.0);
-  std::copy_n(x.begin(), std::min(x.size(), samples_), padded.begin());
+  const std::vector<double> padded = padded_record(x);
   const Spectrum s = forward_fft(padded);
   std::vector<double> e(bands_.size(), 0.0);
   for (std::size_t k = 0; k < padded_; ++k) {
     if (band_[k] < e.size()) e[band_[k]] += std::norm(s[k]);
   }
   return e;
+}
+
+std::vector<std::complex<double>> DriveInverse::band_ratio(const std::vector<double>& measured,
+                                                         const std::vector<double>& predicted) const {
+  const Spectrum y = forward_fft(padded_record(measured)), p = forward_fft(padded_record(predicted));
+  std::vector<std::complex<double>> cross(bands_.size(), 0.0);
+  std::vector<double> power(bands_.size(), 0.0);
+  for (std::size_t k = 1; k <= padded_ / 2; ++k) {
+    if (band_[k] >= cross.size()) continue;
+    cross[band_[k]] += y[k] * std::conj(p[k]);
+    power[band_[k]] += std::norm(p[k]);
+  }
+  for (std::size_t b = 0; b < cross.size(); ++b) cross[b] = power[b] > 0.0 ? cross[b] / power[b] : 0.0;
+  return cross;
 }
 
 }  // namespace rigctl

@@ -5,9 +5,10 @@
 // the largest |H| in the band, so a line the rig hardly passes gets a bounded
 // gain instead of an unbounded one; lines whose coherence is below the gate
 // are not inverted at all (0: the measurement says nothing there). The
-// record is zero-padded before the FFT: the inverse is non-causal (the drive
-// is made offline) and its pre- and post-ringing fall into the padding
-// instead of wrapping round the record.
+// record is padded before the FFT with a smooth return from its end to its
+// start: the inverse is non-causal (the drive is made offline) and its pre-
+// and post-ringing fall into the padding instead of wrapping round the
+// record, and a record that ends elsewhere than it starts has no step.
 #pragma once
 
 #include <vector>
@@ -25,7 +26,7 @@ struct InverseSettings {
   // band's best line), well above what the quarter car's wheel needs at
   // 30 Hz (|H| about 0.3) and far below what noise on a weak line would ask.
   double regularisation = 0.05;
-  double pad_s = 2.0;           // [s] zeros after the record
+  double pad_s = 2.0;           // [s] after the record: its smooth return to the start (spectrum.hpp)
 };
 
 // Bands in which the iteration's gain is adjusted: below the band, then
@@ -45,11 +46,18 @@ class DriveInverse {
   std::vector<double> apply(const std::vector<double>& x, const std::vector<double>& gain) const;
   // Per gain band, the record's energy (for telling where the error grew).
   std::vector<double> band_energy(const std::vector<double>& x) const;
+  // Per gain band, how the rig answered against the model: sum Y conj(P) /
+  // sum |P|^2 over the band's bins, Y the measured and P the predicted
+  // record (deviations from rest); 0 where P has no energy.
+  std::vector<std::complex<double>> band_ratio(const std::vector<double>& measured,
+                                               const std::vector<double>& predicted) const;
 
   const GainBands& bands() const { return bands_; }
   std::size_t lines_gated() const { return gated_; }
 
  private:
+  std::vector<double> padded_record(const std::vector<double>& x) const;
+
   std::size_t samples_, padded_;
   double period_s_;
   GainBands bands_;

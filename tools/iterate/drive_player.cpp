@@ -1,5 +1,6 @@
 #include "tools/iterate/drive_player.hpp"
 
+#include <algorithm>
 #include <sstream>
 
 #include "tools/identify/excitation_profile.hpp"
@@ -47,13 +48,20 @@ PlayResult play_drive(const RigConfig& config, const std::vector<double>& drive,
   }
   const std::string setpoint = setpoint_name_for(config.rig);
   RunFileOptions columns;
-  columns.required = {setpoint, channel};
+  for (const std::string& name : {setpoint, channel, config.controller.feedback, config.controller.output}) {
+    if (std::find(columns.required.begin(), columns.required.end(), name) == columns.required.end()) columns.required.push_back(name);
+  }
   const RunFile run = read_run_file(s.csv_path, columns);
   const auto settle_ticks = static_cast<std::size_t>(s.settle_s / run.dt);
   const std::size_t start = find_excitation_start(run.col(setpoint), s.operating_point, deviation, settle_ticks);
-  const auto& y = run.col(channel);
-  r.response.assign(y.begin() + static_cast<std::ptrdiff_t>(start),
-                    y.begin() + static_cast<std::ptrdiff_t>(start + drive.size()));
+  auto over_drive = [&](const std::string& name) {
+    const auto& y = run.col(name);
+    return std::vector<double>(y.begin() + static_cast<std::ptrdiff_t>(start),
+                               y.begin() + static_cast<std::ptrdiff_t>(start + drive.size()));
+  };
+  r.response = over_drive(channel);
+  r.feedback = over_drive(config.controller.feedback);
+  r.command = over_drive(config.controller.output);
   r.drive_start_s = run.t[start];
   r.completed = true;
   return r;

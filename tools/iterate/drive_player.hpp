@@ -29,6 +29,8 @@ struct PlayResult {
   bool completed = false;        // false: a limit tripped or a stop was requested
   std::string end_reason;        // why the run ended when it did not complete
   std::vector<double> response;  // the channel over the drive's ticks
+  std::vector<double> feedback;  // the controller's feedback (the rod) over them
+  std::vector<double> command;   // the controller's output (the valve command) over them
   double drive_start_s = 0.0;    // run-file time of the drive's first tick
 };
 

@@ -9,13 +9,25 @@ namespace rigctl {
 
 namespace {
 
-// The response may overshoot the drive's velocity (the loop's resonance,
-// the sensor noise the rate detector also sees): the drive keeps 30 % clear
-// of the rate detector's level.
+// The predicted rod keeps 30 % clear of the rate detector's level: the
+// detector also sees the sensor's noise, and the prediction's error on the
+// first drive (before a measured ratio corrects it) was up to 15 % in the
+// tests (docs/drive-iteration.md 3).
 constexpr double kVelocityShare = 0.7;
-// The valve's command also carries the error correction and the leakage's
-// hold (-0.043 on the quarter car): the drive may need at most 80 % of it.
+// The predicted command (the hold included) may reach 80 % of the output
+// limit: the rest is for the loop's correction of what the model missed
+// (friction, the noise) and the prediction's own error.
 constexpr double kEffortShare = 0.8;
+// The predicted rod keeps 3 % of the trip range (`limits:` of the feedback,
+// 5.5 mm of the quarter car's 184 mm) clear of it at either end: the
+// prediction of a slow swing is good to a fraction of a millimetre, and the
+// loop's tracking of the largest swing adds a few.
+constexpr double kStrokeMargin = 0.03;
+// The drive may pass the setpoint range by 10^-4 of its width (16 um on the
+// quarter car, below its LVDT's 20 um noise): a target that holds at home,
+// the range's bottom, and was resampled or quantised in a file comes back
+// a fraction of a micrometre below it, and the drive follows the target there.
+constexpr double kPositionTolerance = 1e-4;
 
 std::string fmt(double v) {
   char b[32];
@@ -30,6 +42,9 @@ DriveLimits drive_limits(const RigConfig& c) {
   l.position_min = c.safety.setpoint_min;
   l.position_max = c.safety.setpoint_max;
   l.position_source = "safety.setpoint_range";
+  l.stroke_min = l.position_min;
+  l.stroke_max = l.position_max;
+  l.stroke_source = l.position_source;
   for (const auto& lim : c.limits) {
     if (lim.channel != c.controller.feedback) continue;
     if (lim.min > l.position_min || lim.max < l.position_max) {
@@ -37,6 +52,10 @@ DriveLimits drive_limits(const RigConfig& c) {
       l.position_max = std::min(l.position_max, lim.max);
       l.position_source = "safety.setpoint_range and limits." + lim.channel;
     }
+    const double margin = kStrokeMargin * (lim.max - lim.min);
+    l.stroke_min = lim.min + margin;
+    l.stroke_max = lim.max - margin;
+    l.stroke_source = "limits." + lim.channel + " less " + fmt(100 * kStrokeMargin) + " %";
   }
   l.velocity_max = std::numeric_limits<double>::infinity();
   for (const auto& d : c.safety.detectors) {
@@ -53,36 +72,15 @@ DriveLimits drive_limits(const RigConfig& c) {
   return l;
 }
 
-double predicted_valve_effort(const RigConfig& c, double v, double command_hold) {
-  if (c.rig != RigKind::kQuarterCar) return 0.0;
-  const QuarterCarParams& p = c.quarter_car;
-  // Flow continuity through the supply edge and the return edge at velocity v,
-  // Q_in = Kv u sqrt(Ps - p_in), Q_out = Kv u sqrt(p_out), with the force
-  // balance A1 p1 - A2 p2 = F (the static load of rod, wheel and body):
-  // extending (v > 0) gives (v / Kv u)^2 = (A1 Ps - F) / (A1^3 + A2^3),
-  // retracting (F + A2 Ps) / (A1^3 + A2^3). The inertia forces are left out:
-  // they are small beside the supply's force on the quarter car (40 kN).
-  const double weight = (p.mass_rod + p.mass_wheel + p.mass_body) * p.gravity;
-  const double cubes = std::pow(p.area_cap, 3) + std::pow(p.area_rod, 3);
-  const double drive_force = v >= 0.0 ? p.area_cap * p.supply_pressure - weight : p.area_rod * p.supply_pressure + weight;
-  if (drive_force <= 0.0) return std::numeric_limits<double>::infinity();
-  const double speed_per_command = p.valve_flow_gain * std::sqrt(drive_force / cubes);
-  return std::abs(command_hold + v / speed_per_command);
-}
-
-DrivePeaks drive_peaks(const RigConfig& c, const std::vector<double>& d, double op, double command_hold) {
+DrivePeaks drive_peaks(const std::vector<double>& d, double op, double dt, const PredictedMotion& predicted) {
   DrivePeaks k;
+  k.predicted = predicted;
   if (d.empty()) return k;
   const auto [lo, hi] = std::minmax_element(d.begin(), d.end());
   k.min = *lo;
   k.max = *hi;
   k.displacement = std::max(op - k.min, k.max - op);
-  const double dt = c.loop.period_s;
-  for (std::size_t i = 1; i < d.size(); ++i) {
-    const double v = (d[i] - d[i - 1]) / dt;
-    k.velocity = std::max(k.velocity, std::abs(v));
-    k.valve_effort = std::max(k.valve_effort, predicted_valve_effort(c, v, command_hold));
-  }
+  for (std::size_t i = 1; i < d.size(); ++i) k.velocity = std::max(k.velocity, std::abs(d[i] - d[i - 1]) / dt);
   return k;
 }
 
@@ -99,21 +97,23 @@ DriveVerdict check_drive(const DrivePeaks& k, const DriveLimits& l, double op) {
       v.reason = why;
     }
   };
-  if (k.max > op) {
-    take((l.position_max - op) / (k.max - op),
-         "stroke: the drive reaches " + fmt(k.max) + ", above " + l.position_source + " max " + fmt(l.position_max));
+  // slack: how far past the limit still counts as within it.
+  auto range = [&](double low, double high, double limit_low, double limit_high, double slack, const std::string& what,
+                   const std::string& source) {
+    if (high > op) take((limit_high + slack - op) / (high - op), "stroke: " + what + fmt(high) + ", above " + source + " max " + fmt(limit_high));
+    if (low < op) take((op - limit_low + slack) / (op - low), "stroke: " + what + fmt(low) + ", below " + source + " min " + fmt(limit_low));
+  };
+  range(k.min, k.max, l.position_min, l.position_max, kPositionTolerance * (l.position_max - l.position_min),
+        "the drive reaches ", l.position_source);
+  const PredictedMotion& p = k.predicted;
+  range(p.rod_min, p.rod_max, l.stroke_min, l.stroke_max, 0.0, "the rod is predicted to reach ", l.stroke_source);
+  if (p.rod_velocity > 0.0) {
+    take(l.velocity_max / p.rod_velocity, "velocity: the rod is predicted to move at " + fmt(p.rod_velocity) +
+                                               " beyond " + l.velocity_source + " " + fmt(l.velocity_max));
   }
-  if (k.min < op) {
-    take((op - l.position_min) / (op - k.min),
-         "stroke: the drive reaches " + fmt(k.min) + ", below " + l.position_source + " min " + fmt(l.position_min));
-  }
-  if (k.velocity > 0.0) {
-    take(l.velocity_max / k.velocity,
-         "velocity: the drive moves at " + fmt(k.velocity) + " beyond " + l.velocity_source + " " + fmt(l.velocity_max));
-  }
-  if (k.valve_effort > 0.0) {
-    // The effort is proportional to the velocity (the hold aside): scale alike.
-    take(l.effort_max / k.valve_effort, "flow: the drive needs a valve effort of " + fmt(k.valve_effort) +
+  if (p.valve_effort > 0.0) {
+    // The effort is nearly proportional to the swing (the hold aside): scale alike.
+    take(l.effort_max / p.valve_effort, "flow: the drive needs a valve effort of " + fmt(p.valve_effort) +
                                             " beyond " + l.effort_source + " " + fmt(l.effort_max));
   }
   return v;

@@ -21,7 +21,12 @@ struct IterateOptions {
   std::string config_path;
   std::string case_name;
   std::string target_path;  // run file (t, channel) or RPC III (.rsp, .tim)
-  std::string channel;      // the target channel, e.g. x_w
+  std::string channel;      // the rig's channel the target is for, e.g. x_w
+  std::string target_channel;  // the file's channel: a name or a 1-based number (default: `channel`)
+  // Longest target played [s]: a drive is one run; ten minutes is well
+  // beyond a road simulator's usual block (20-120 s) and keeps the record's
+  // FFTs and files small. A longer target is refused, not truncated.
+  double max_length_s = 600.0;
   std::string out_dir;
   std::string frf_path;     // FRF file from rigctl identify
   std::string model_path;   // diagnosis JSON: the model it extended

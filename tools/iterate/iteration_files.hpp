@@ -15,6 +15,11 @@ namespace rigctl {
 
 struct IterationSummary {
   std::string config, target, channel, frf_source, rig;
+  std::string target_channel;     // the file's channel taken
+  double target_period_s = 0.0;   // the file's own period (resampled to the loop's when it differs)
+  double target_start_s = 0.0;    // the file's first time
+  double first_level = 1.0, max_growth = 0.0;
+  double period_s = 0.0;          // the loop's (the window's times)
   double operating_point = 0.0;
   double band_min_hz = 0.0, band_max_hz = 0.0;
   double tolerance_percent = 0.0;

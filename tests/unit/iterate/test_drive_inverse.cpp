@@ -109,7 +109,7 @@ TEST(MatchMetrics, RelativeErrorCorrelationAndPeak) {
   EXPECT_NEAR(m.rel_rms_percent, 10.0, 1e-6);
   EXPECT_NEAR(m.trac, 1.0, 1e-12);
   double peak = 0;
-  const auto tb = band_limited(t, kDt, 0.5, 30.0);
+  const auto tb = band_passed(t, kDt, 0.5, 30.0);
   for (double v : tb) peak = std::max(peak, 0.1 * std::abs(v));
   EXPECT_NEAR(m.peak_error, peak, 1e-9);
   const auto other = band_noise(4000, 0.5, 30.0, 6);
@@ -118,6 +118,20 @@ TEST(MatchMetrics, RelativeErrorCorrelationAndPeak) {
   std::vector<double> shifted(t);
   for (double& v : shifted) v += 0.08;
   EXPECT_LT(match_metrics(t, shifted, kDt, 0.5, 30.0).rel_rms_percent, 1e-6);
+}
+
+// The error that counts is the one over the test part: an error outside it
+// shows in the whole record's figure only.
+TEST(MatchMetrics, TheWindowsErrorAndTheWholeRecordsBesideIt) {
+  const auto t = band_noise(4000, 0.5, 30.0, 5);
+  std::vector<double> r(t);
+  for (std::size_t i = 3000; i < 4000; ++i) r[i] *= 1.5;  // wrong in the last 2.5 s only
+  const TestWindow first{0, 2000, "--window"};
+  const auto m = match_metrics(t, r, kDt, 0.5, 30.0, first);
+  EXPECT_LT(m.rel_rms_percent, 3.0);  // the band-pass spreads a little of the error's sudden start (1.8 %)
+  EXPECT_GT(m.whole_rel_rms_percent, 20.0);
+  const TestWindow last{3200, 3800, "--window"};
+  EXPECT_NEAR(match_metrics(t, r, kDt, 0.5, 30.0, last).rel_rms_percent, 50.0, 5.0);
 }
 
 }  // namespace

@@ -35,20 +35,20 @@ std::string table(const std::string& bad_cell_row = "") {
 }
 
 TEST(TargetFile, TakesTheChannelAndIgnoresOtherColumns) {
-  const auto x = read_target(write("t_ok.csv", table()), "x_w", 0.0025);
+  const auto x = read_target(write("t_ok.csv", table()), "x_w", 0.0025, 600.0).values;
   ASSERT_EQ(x.size(), 40u);
   EXPECT_NEAR(x[7], 0.087, 1e-12);
 }
 
 TEST(TargetFile, ErrorsNameTheMissingColumnAndTheBadLine) {
   try {
-    read_target(write("t_missing.csv", table()), "x_b", 0.0025);
+    read_target(write("t_missing.csv", table()), "x_b", 0.0025, 600.0);
     FAIL();
   } catch (const RunFileError& e) {
     EXPECT_NE(std::string(e.what()).find("x_b"), std::string::npos) << e.what();
   }
   try {
-    read_target(write("t_bad.csv", table("12")), "x_w", 0.0025);
+    read_target(write("t_bad.csv", table("12")), "x_w", 0.0025, 600.0);
     FAIL();
   } catch (const RunFileError& e) {
     const std::string m = e.what();
@@ -57,12 +57,23 @@ TEST(TargetFile, ErrorsNameTheMissingColumnAndTheBadLine) {
   }
 }
 
-TEST(TargetFile, ResamplesToTheLoopPeriod) {
-  const std::vector<double> x{0.0, 1.0, 2.0, 3.0};
-  const auto y = resample(x, 0.005, 0.0025);
-  ASSERT_EQ(y.size(), 7u);
-  EXPECT_DOUBLE_EQ(y[1], 0.5);
-  EXPECT_DOUBLE_EQ(y[6], 3.0);
+TEST(TargetFile, ChannelByNumberAndTheLengthLimit) {
+  const std::string p = write("t_number.csv", table());
+  const Target t = read_target(p, "2", 0.0025, 600.0);  // t, notes, x_w: the second column after t
+  EXPECT_EQ(t.channel, "x_w");
+  EXPECT_NEAR(t.values[7], 0.087, 1e-12);
+  try {
+    read_target(p, "9", 0.0025, 600.0);
+    FAIL();
+  } catch (const RunFileError& e) {
+    EXPECT_NE(std::string(e.what()).find("no column number 9"), std::string::npos) << e.what();
+  }
+  try {
+    read_target(p, "x_w", 0.0025, 0.05);  // 40 samples are 0.1 s
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("--max-length"), std::string::npos) << e.what();
+  }
 }
 
 TEST(TargetFile, ReadsRpcTimeHistories) {
@@ -72,7 +83,7 @@ TEST(TargetFile, ReadsRpcTimeHistories) {
   for (std::size_t i = 0; i < 3000; ++i) f.channels[0].values[i] = 0.08 + 0.01 * std::sin(0.01 * static_cast<double>(i));
   const std::string p = temp_path("target.tim");
   write_rpc3_file(f, p, Rpc3DataType::kFloatingPoint);
-  const auto x = read_target(p, "x_w", 0.0025);
+  const auto x = read_target(p, "x_w", 0.0025, 600.0).values;
   ASSERT_GE(x.size(), 3000u);
   EXPECT_NEAR(x[1234], f.channels[0].values[1234], 1e-7);
 }
