@@ -12,6 +12,7 @@
 #include "tools/diagnosis/diagnose_command.hpp"
 #include "tools/hidden_effects/make_run.hpp"
 #include "tools/bridge/bridge_command.hpp"
+#include "tools/catalog/catalog_command.hpp"
 #include "tools/identify/identify_command.hpp"
 #include "tools/iterate/iterate_command.hpp"
 #include "tools/iterate/road_target_command.hpp"
@@ -75,6 +76,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> run_fault_texts;
   std::string run_ws;
   run_cmd->add_option("--ws", run_ws, "Serve the telemetry to Foxglove/Lichtblick on a WebSocket, [ADDR:]PORT (default address 127.0.0.1; port 0: any free port); overrides telemetry.websocket (docs/foxglove.md)");
+  run_cmd->add_option("--catalog", run.catalog_path, "Run catalog to enter the run into (SQLite, created on first use); overrides the config's catalog.path (docs/rig-health.md)");
   run_cmd->add_option("--fault", run_fault_texts, "Inject a fault in the simulated driver, KIND@TIME[:ARG...] (stuck, rail, noise, nan, offset, overrun, supply, burst; SAFETY.md); repeatable");
 
   std::string log_in, csv_out, prefix = "RIGCTL_";
@@ -260,6 +262,37 @@ int main(int argc, char** argv) {
   road_cmd->add_option("--channel", road.channel, "Column name of the wheel displacement")->capture_default_str();
   road_cmd->add_option("--out", road.out_path, "Run file to write (CSV), or RPC III (.rsp, .tim)")->required();
 
+  // The run catalog (issue 32, docs/rig-health.md): one subcommand each, shared options.
+  rigctl::CatalogCommandOptions cat;
+  auto* cat_cmd = app.add_subcommand("catalog", "The rig's run catalog (SQLite): add, list, show, query, repair (docs/rig-health.md)");
+  cat_cmd->require_subcommand(1);
+  std::vector<std::pair<CLI::App*, rigctl::CatalogAction>> cat_actions;
+  auto cat_sub = [&](const char* name, const char* what, rigctl::CatalogAction action) {
+    auto* c = cat_cmd->add_subcommand(name, what);
+    c->add_option("--catalog", cat.catalog_path, "Catalog file (default: the --config's catalog.path)");
+    c->add_option("--config", cat.config_path, "Rig config: its catalog.path and catalog.rig_name")->check(CLI::ExistingFile);
+    cat_actions.emplace_back(c, action);
+    return c;
+  };
+  auto* cat_add = cat_sub("add", "Enter recorded runs (RUN.lcm or RUN.csv)", rigctl::CatalogAction::kAdd);
+  cat_add->add_option("records", cat.records, "LCM logs or CSV run files")->required()->check(CLI::ExistingFile);
+  for (auto* c : {cat_add, cat_sub("repair", "Complete killed runs from their logs; enter the logs of --log-dir not in the catalog", rigctl::CatalogAction::kRepair)}) {
+    c->add_option("--rig-name", cat.rig_name, "The rig's name in the catalog (default: the config's, else the rig kind)");
+    c->add_option("--channel-prefix", cat.channel_prefix, "Telemetry channel prefix of the logs")->capture_default_str();
+  }
+  cat_actions.back().first->add_option("--log-dir", cat.log_dir, "Folder of the rig's run logs")->check(CLI::ExistingDirectory);
+  cat_sub("show", "One run in full: fields, channel statistics, diagnoses", rigctl::CatalogAction::kShow)
+      ->add_option("id", cat.run_id, "Run id")->required();
+  for (auto* c : {cat_sub("list", "Runs as a table, oldest first", rigctl::CatalogAction::kList),
+                  cat_sub("query", "Runs as JSON with their channel statistics", rigctl::CatalogAction::kQuery)}) {
+    c->add_option("--rig", cat.rig, "Rig name or kind");
+    c->add_option("--since", cat.since, "Started at or after (UTC, e.g. 2026-11-01 or 2026-11-01T08:00)");
+    c->add_option("--until", cat.until, "Started before (UTC)");
+    c->add_option("--end-reason", cat.end_reason, "completed, faulted, interrupted, killed, running, unknown");
+    c->add_option("--where", cat.where, "CHANNEL.STAT<VALUE or >VALUE (stat: min, max, mean, std, rms), e.g. x_r.max>0.05; repeatable");
+  }
+
+
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -334,6 +367,8 @@ int main(int argc, char** argv) {
       return rigctl::run_bench(bench, g_stop, std::cout);
     }
     if (diag_cmd->parsed()) return rigctl::run_diagnose(diag, std::cout, std::cerr);
+    for (const auto& [c, action] : cat_actions)
+      if (c->parsed()) return rigctl::run_catalog_command(action, cat, std::cout, std::cerr);
     if (l2m->parsed()) {
       const auto result = rigctl::log_to_mcap(mcap_in, mcap_out, mcap_prefix);
       std::cout << "log2mcap: " << result.messages << " messages in " << result.chunks << " chunks written to " << mcap_out;

@@ -25,6 +25,7 @@ LAYER_OF_FOLDER = {
     'config': 'config',
     'tools/run': 'run', 'tools/cmd': 'run', 'tools/rig_sim': 'run', 'tools/runfile': 'run', 'tools/common': 'run',
     'tools/bridge': 'run',
+    'tools/catalog': 'run',  # the run catalog: `rigctl run` enters its runs (docs/rig-health.md)
     'tools/hidden_effects': 'hidden_effects',
     'tools/diagnosis': 'diagnosis',
     'tools/suspension': 'suspension',
