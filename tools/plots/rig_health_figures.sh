@@ -17,6 +17,7 @@ for f in "$work"/series/block-*.csv; do
   "$rigctl" health analyse "$f" --catalog "$work/catalog.sqlite" --rig-name series --window 20 \
     --config config/quarter_car.yaml >/dev/null
 done
-"$rigctl" health report --catalog "$work/catalog.sqlite" --rig series --json "$out/trends.json" \
-  --html "$out/report.html" --png "$out/trends.png"
-cp "$work/series/series.json" "$out/series.json"
+"$rigctl" health report --catalog "$work/catalog.sqlite" --rig series --json "$work/trends.json" \
+  --html "$work/report.html"
+/usr/bin/python3 "$root/tools/plots/plot_health.py" "$work/trends.json" --out "$out/trends.png" \
+  --parameters R_l,beta,kv_scale,tau_r
