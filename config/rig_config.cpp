@@ -64,6 +64,15 @@ TelemetryConfig read_telemetry(ConfigReader r) {
   return c;
 }
 
+CatalogConfig read_catalog(ConfigReader r) {
+  CatalogConfig c;
+  c.path = r.text("path");
+  if (c.path.empty()) r.fail("path", "expected the catalog's file, e.g. runs/catalog.sqlite");
+  if (r.has("rig_name")) c.rig_name = r.text("rig_name");
+  r.reject_unknown_keys();
+  return c;
+}
+
 PiConfig read_pi(ConfigReader& r, double period_s) {
   PiConfig pi;
   pi.kp = r.number("kp", 0.0, 1e6);
@@ -213,6 +222,7 @@ RigConfig parse(ConfigReader root, const std::string& case_name) {
   if (root.has("safety")) c.safety = read_safety(root.child("safety"));
   if (root.has("operator")) c.operator_commands = read_operator(root.child("operator"), c.file);
   if (root.has("identify")) c.identify = read_identify(root.child("identify"));
+  if (root.has("catalog")) c.catalog = read_catalog(root.child("catalog"));
   if (root.has("faults")) {
     for (const auto& text : root.texts("faults", [](const std::string& t) { parse_fault_spec(t); })) {
       c.faults.push_back(parse_fault_spec(text));

@@ -54,6 +54,14 @@ struct TelemetryConfig {
   std::optional<WebsocketConfig> websocket;
 };
 
+// `catalog:` (optional): the run catalog of this rig PC (docs/rig-health.md),
+// one SQLite file that `rigctl run` enters every run into; `--catalog`
+// overrides the path. Without it (and without --catalog) no run is entered.
+struct CatalogConfig {
+  std::string path;      // relative to the working directory, like telemetry.log_dir
+  std::string rig_name;  // this rig's name in the lab; default: the rig kind (quarter_car)
+};
+
 struct ControllerConfig {
   ControllerKind type = ControllerKind::kPi;  // one of the rig's own (rig_of)
   std::string feedback;     // input channel name
@@ -135,6 +143,7 @@ struct RigConfig {
   OperatorConfig operator_commands;  // `operator:`; optional (config/operator_config.hpp)
   std::vector<FaultSpec> faults;     // `faults:`; optional list of KIND@TIME[:ARG...] (drivers/sim/sim_faults.hpp)
   IdentifyConfig identify;           // `identify:`; optional (config/identify_config.hpp)
+  std::optional<CatalogConfig> catalog;  // `catalog:`; optional
   QuarterCarParams quarter_car;          // rig quarter_car
   PneumaticRotaryParams pneumatic_rotary;  // rig pneumatic_rotary
   HalfCarParams half_car;                  // rig half_car

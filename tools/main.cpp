@@ -10,8 +10,11 @@
 #include "tools/bench/bench_command.hpp"
 #include "tools/cmd/cmd_command.hpp"
 #include "tools/diagnosis/diagnose_command.hpp"
+#include "tools/health/health_command.hpp"
+#include "tools/health/make_series.hpp"
 #include "tools/hidden_effects/make_run.hpp"
 #include "tools/bridge/bridge_command.hpp"
+#include "tools/catalog/catalog_command.hpp"
 #include "tools/identify/identify_command.hpp"
 #include "tools/iterate/iterate_command.hpp"
 #include "tools/iterate/road_target_command.hpp"
@@ -75,6 +78,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> run_fault_texts;
   std::string run_ws;
   run_cmd->add_option("--ws", run_ws, "Serve the telemetry to Foxglove/Lichtblick on a WebSocket, [ADDR:]PORT (default address 127.0.0.1; port 0: any free port); overrides telemetry.websocket (docs/foxglove.md)");
+  run_cmd->add_option("--catalog", run.catalog_path, "Run catalog to enter the run into (SQLite, created on first use); overrides the config's catalog.path (docs/rig-health.md)");
   run_cmd->add_option("--fault", run_fault_texts, "Inject a fault in the simulated driver, KIND@TIME[:ARG...] (stuck, rail, noise, nan, offset, overrun, supply, burst; SAFETY.md); repeatable");
 
   std::string log_in, csv_out, prefix = "RIGCTL_";
@@ -151,6 +155,8 @@ int main(int argc, char** argv) {
   diag_cmd->add_flag("--drop-bad-rows", diag.drop_bad_rows, "Drop (and count) rows with bad cells instead of failing");
   diag_cmd->add_option("--decimate", diag.decimate, "Keep every Nth sample (default: the rig's choice)");
   diag_cmd->add_flag("--quiet", diag.quiet, "No progress on stderr");
+  diag_cmd->add_option("--catalog", diag.catalog_path, "Also write the diagnosis into this run catalog, linked to the run (docs/rig-health.md)");
+  diag_cmd->add_option("--rig-name", diag.rig_name, "With --catalog: the rig's name for a run not yet entered (default: the rig kind)");
 
   rigctl::MakeRunOptions make;
   std::string make_rig;
@@ -266,6 +272,76 @@ int main(int argc, char** argv) {
   road_cmd->add_option("--channel", road.channel, "Column name of the wheel displacement")->capture_default_str();
   road_cmd->add_option("--out", road.out_path, "Run file to write (CSV), or RPC III (.rsp, .tim)")->required();
 
+  // The run catalog (issue 32, docs/rig-health.md): one subcommand each, shared options.
+  rigctl::CatalogCommandOptions cat;
+  auto* cat_cmd = app.add_subcommand("catalog", "The rig's run catalog (SQLite): add, list, show, query, repair (docs/rig-health.md)");
+  cat_cmd->require_subcommand(1);
+  std::vector<std::pair<CLI::App*, rigctl::CatalogAction>> cat_actions;
+  auto cat_sub = [&](const char* name, const char* what, rigctl::CatalogAction action) {
+    auto* c = cat_cmd->add_subcommand(name, what);
+    c->add_option("--catalog", cat.catalog_path, "Catalog file (default: the --config's catalog.path)");
+    c->add_option("--config", cat.config_path, "Rig config: its catalog.path and catalog.rig_name")->check(CLI::ExistingFile);
+    cat_actions.emplace_back(c, action);
+    return c;
+  };
+  auto* cat_add = cat_sub("add", "Enter recorded runs (RUN.lcm or RUN.csv)", rigctl::CatalogAction::kAdd);
+  cat_add->add_option("records", cat.records, "LCM logs or CSV run files")->required()->check(CLI::ExistingFile);
+  for (auto* c : {cat_add, cat_sub("repair", "Complete killed runs from their logs; enter the logs of --log-dir not in the catalog", rigctl::CatalogAction::kRepair)}) {
+    c->add_option("--rig-name", cat.rig_name, "The rig's name in the catalog (default: the config's, else the rig kind)");
+    c->add_option("--channel-prefix", cat.channel_prefix, "Telemetry channel prefix of the logs")->capture_default_str();
+  }
+  cat_actions.back().first->add_option("--log-dir", cat.log_dir, "Folder of the rig's run logs")->check(CLI::ExistingDirectory);
+  cat_sub("show", "One run in full: fields, channel statistics, diagnoses", rigctl::CatalogAction::kShow)
+      ->add_option("id", cat.run_id, "Run id")->required();
+  for (auto* c : {cat_sub("list", "Runs as a table, oldest first", rigctl::CatalogAction::kList),
+                  cat_sub("query", "Runs as JSON with their channel statistics", rigctl::CatalogAction::kQuery)}) {
+    c->add_option("--rig", cat.rig, "Rig name or kind");
+    c->add_option("--since", cat.since, "Started at or after (UTC, e.g. 2026-11-01 or 2026-11-01T08:00)");
+    c->add_option("--until", cat.until, "Started before (UTC)");
+    c->add_option("--end-reason", cat.end_reason, "completed, faulted, interrupted, killed, running, unknown");
+    c->add_option("--where", cat.where, "CHANNEL.STAT<VALUE or >VALUE (stat: min, max, mean, std, rms), e.g. x_r.max>0.05; repeatable");
+  }
+
+  // Rig health (issue 32, docs/rig-health.md): windows of long runs into the catalog, trends and alarms.
+  rigctl::health::AnalyseOptions hana;
+  rigctl::health::ReportOptions hrep;
+  auto* health_cmd = app.add_subcommand("health", "Rig health: diagnose long runs in windows, trend the rig's parameters, raise alarms (docs/rig-health.md)");
+  health_cmd->require_subcommand(1);
+  auto* hana_cmd = health_cmd->add_subcommand("analyse", "Calibrate the rig's model in windows of a run (RUN.lcm or RUN.csv) into the catalog");
+  hana_cmd->add_option("record", hana.record_path, "LCM log or CSV run file")->required()->check(CLI::ExistingFile);
+  hana_cmd->add_option("--catalog", hana.catalog_path, "Run catalog (SQLite)")->required();
+  hana_cmd->add_option("--window", hana.window_s, "Window length [s]")->capture_default_str()->check(CLI::PositiveNumber);
+  hana_cmd->add_option("--rig-name", hana.rig_name, "The rig's name for a run not yet in the catalog (default: the rig kind)");
+  hana_cmd->add_option("--config", hana.config_path, "Rig config: the model's nominal parameters and controller")->check(CLI::ExistingFile);
+  hana_cmd->add_option("--decimate", hana.decimate, "Keep every Nth sample (default: the rig's choice)");
+  hana_cmd->add_flag("--full", hana.full_diagnosis, "Screen the candidate causes in every window too (the whole diagnosis; slow)");
+  hana_cmd->add_flag("--follow", hana.follow, "The LCM log is still being written: analyse windows as they complete, until the run ends");
+  auto* hrep_cmd = health_cmd->add_subcommand("report", "Parameter trends with uncertainty bands, CUSUM change detection and alarms");
+  hrep_cmd->add_option("--catalog", hrep.catalog_path, "Run catalog (SQLite)")->required()->check(CLI::ExistingFile);
+  hrep_cmd->add_option("--rig", hrep.rig_name, "The rig's name in the catalog")->required();
+  hrep_cmd->add_option("--json", hrep.json_path, "Write the trends and alarms as JSON");
+  hrep_cmd->add_option("--html", hrep.html_path, "Write a self-contained HTML page with the trends");
+  hrep_cmd->add_option("--png", hrep.png_path, "Plot the trends (PNG; needs matplotlib: setup.sh --plots)");
+  hrep_cmd->add_option("--reference", hrep.trends.reference_points, "Windows that set each parameter's reference")->capture_default_str()->check(CLI::PositiveNumber);
+  hrep_cmd->add_option("--cusum-k", hrep.trends.cusum.k, "CUSUM allowance [sd]")->capture_default_str()->check(CLI::PositiveNumber);
+  hrep_cmd->add_option("--cusum-h", hrep.trends.cusum.h, "CUSUM threshold [sd]")->capture_default_str()->check(CLI::PositiveNumber);
+
+  rigctl::health::SeriesOptions series;
+  std::string series_rig = "quarter_car";
+  auto* series_cmd = app.add_subcommand("make-series", "A simulated durability series: blocks of runs of one drawn rig while its leakage and friction grow (rig health tests)");
+  series_cmd->add_option("--rig", series_rig, "Rig kind (drifts: quarter_car)")->capture_default_str();
+  series_cmd->add_option("--config", series.config_path, "Rig config (default: config/<rig>.yaml)");
+  series_cmd->add_option("--case", series.case_name, "Excitation case (default: the rig's diagnosis case)");
+  series_cmd->add_option("--out", series.out_dir, "Folder for block-NNN.csv and series.json")->required();
+  series_cmd->add_option("--blocks", series.blocks, "Runs in the series")->capture_default_str()->check(CLI::PositiveNumber);
+  series_cmd->add_option("--block-hours", series.block_spacing_h, "Hours between block starts")->capture_default_str()->check(CLI::PositiveNumber);
+  series_cmd->add_option("--start", series.start_utc, "Start of the first block (UTC)")->capture_default_str();
+  series_cmd->add_option("--seed", series.seed, "Seed of the rig's draw (each block's noise is its own)")->capture_default_str();
+  series_cmd->add_option("--tolerance", series.tolerance, "Half-width of the rig's parameter draw")->capture_default_str();
+  series_cmd->add_option("--leakage-growth", series.leakage_growth, "Leakage conductance growth over the series, a fraction (0.5: +50 %)")->capture_default_str();
+  series_cmd->add_option("--friction-growth", series.friction_growth, "Rod friction growth over the series, a fraction")->capture_default_str();
+  series_cmd->add_option("--duration", series.duration_s, "Block length [s] (default: the excitation's)");
+
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -341,6 +417,18 @@ int main(int argc, char** argv) {
       return rigctl::run_bench(bench, g_stop, std::cout);
     }
     if (diag_cmd->parsed()) return rigctl::run_diagnose(diag, std::cout, std::cerr);
+    if (hana_cmd->parsed()) {
+      install_stop_handlers();
+      return rigctl::health::run_health_analyse(hana, g_stop, std::cout, std::cerr);
+    }
+    if (series_cmd->parsed()) {
+      series.rig = rigctl::parse_kind<rigctl::RigKind>(series_rig);
+      rigctl::health::make_series(series, std::cerr);
+      return 0;
+    }
+    if (hrep_cmd->parsed()) return rigctl::health::run_health_report(hrep, std::cout, std::cerr);
+    for (const auto& [c, action] : cat_actions)
+      if (c->parsed()) return rigctl::run_catalog_command(action, cat, std::cout, std::cerr);
     if (l2m->parsed()) {
       const auto result = rigctl::log_to_mcap(mcap_in, mcap_out, mcap_prefix);
       std::cout << "log2mcap: " << result.messages << " messages in " << result.chunks << " chunks written to " << mcap_out;

@@ -25,8 +25,10 @@ LAYER_OF_FOLDER = {
     'config': 'config',
     'tools/run': 'run', 'tools/cmd': 'run', 'tools/rig_sim': 'run', 'tools/runfile': 'run', 'tools/common': 'run',
     'tools/bridge': 'run',
+    'tools/catalog': 'run',  # the run catalog: `rigctl run` enters its runs (docs/rig-health.md)
     'tools/hidden_effects': 'hidden_effects',
     'tools/diagnosis': 'diagnosis',
+    'tools/health': 'health',  # windows of long runs, trends, change detection, make-series
     'tools/suspension': 'suspension',
     'tools/bench': 'bench',
     'tools/identify': 'identify',
@@ -55,12 +57,13 @@ BELOW['config'] = {'base', 'plant', 'drivers'} | RT
 BELOW['run'] = BELOW['config'] | {'config', 'lcmtypes', 'foxglove'}
 BELOW['hidden_effects'] = BELOW['run'] | {'run'}
 BELOW['diagnosis'] = BELOW['hidden_effects'] | {'hidden_effects'}
+BELOW['health'] = BELOW['diagnosis'] | {'diagnosis'}
 BELOW['suspension'] = BELOW['run'] | {'run'}
 BELOW['bench'] = BELOW['diagnosis'] | {'diagnosis', 'suspension'}
 BELOW['identify'] = BELOW['run'] | {'run'}
 BELOW['tune'] = BELOW['identify'] | {'identify'}
 BELOW['iterate'] = BELOW['tune'] | {'tune'} | BELOW['hidden_effects'] | {'hidden_effects'}
-BELOW['program'] = BELOW['bench'] | {'bench'} | BELOW['iterate'] | {'iterate'}
+BELOW['program'] = BELOW['bench'] | {'bench'} | BELOW['iterate'] | {'iterate'} | BELOW['health'] | {'health'}
 
 SOURCE_FOLDERS = ('rt', 'plant', 'drivers', 'foxglove', 'config', 'tools')
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"')

@@ -5,6 +5,8 @@
 #include <sstream>
 
 #include "config/config_reader.hpp"
+#include "tools/catalog/run_summary.hpp"
+#include "tools/diagnosis/catalog_record.hpp"
 #include "tools/diagnosis/engine.hpp"
 #include "tools/diagnosis/model.hpp"
 #include "tools/runfile/run_file.hpp"
@@ -56,6 +58,20 @@ int run_diagnose(const DiagnoseCommandOptions& o, std::ostream& out, std::ostrea
         << " pp, confidence " << c.confidence << ")" << std::defaultfloat;
     for (const auto& p : c.parameters) out << " " << p.name << "=" << std::setprecision(5) << p.value;
     out << "\n";
+  }
+  if (!o.catalog_path.empty()) {
+    try {
+      catalog::Catalog c(o.catalog_path);
+      const auto run = diag::catalog_run_of(c, o.data_path, o.rig_name);
+      const double start_s = d.t.empty() ? 0.0 : d.t.front();
+      const double end_s = d.t.empty() ? 0.0 : d.t.back();
+      const int64_t id = c.add_diagnosis(diag::catalog_record(
+          d, {run.id, start_s, end_s, catalog::utc_seconds(run.start_utc) + start_s, run.rig_name}));
+      out << "catalog: diagnosis " << id << " of run " << run.id << " in " << o.catalog_path << "\n";
+    } catch (const std::exception& e) {
+      err << "rigctl diagnose: catalog: " << one_line(e.what()) << "\n";
+      return 1;
+    }
   }
   auto write = [&](const std::string& path, auto&& fn) -> bool {
     std::ofstream f(path);

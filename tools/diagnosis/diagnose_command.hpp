@@ -17,6 +17,10 @@ struct DiagnoseCommandOptions {
   bool drop_bad_rows = false;
   int decimate = 0;  // 0: the rig's default
   bool quiet = false;
+  // --catalog: the diagnosis goes into the run catalog, linked to the run of
+  // --data (entered first when it is not there yet; docs/rig-health.md 2).
+  std::string catalog_path;
+  std::string rig_name;  // --rig-name: the rig's name there (default: the rig kind)
 };
 
 // Returns the exit code: 0 with a diagnosis (including `none`), 2 for bad

@@ -485,7 +485,7 @@ Diagnosis diagnose(const RigModel& model, const DiagnoseOptions& opt) {
   }
   Scored current = base;
   std::vector<std::size_t> active;
-  for (int round = 1; round <= opt.max_effects; ++round) {
+  for (int round = 1; round <= (opt.calibration_only ? 0 : opt.max_effects); ++round) {
     auto screened = screen(w, current, active, round);
     if (screened.empty()) break;
     const auto refits = refit_best(w, std::move(screened), current, active, round, d);
@@ -498,8 +498,10 @@ Diagnosis diagnose(const RigModel& model, const DiagnoseOptions& opt) {
     active.push_back(win->effect);
     current = recalibrate(w, win->s, active);  // a rejected candidate stays in the pool: it may pass later
   }
-  backward_check(w, active, current, d);
-  check_unexplained(w, current, d);
+  if (!opt.calibration_only) {
+    backward_check(w, active, current, d);
+    check_unexplained(w, current, d);
+  }
   finish(w, active, base, current, d);
   d.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   w.say("done: cause " + d.cause);

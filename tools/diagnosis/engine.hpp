@@ -115,6 +115,12 @@ struct DiagnoseOptions {
   double ambiguity_margin = 0.5;
   int refit_top = 3;              // K
   int max_effects = 3;
+  // Rig health (docs/rig-health.md 3): calibrate the baseline only, no
+  // candidate screened, and the parameters that stand for a cause free beyond
+  // their band: a window's calibrated leakage resistance is then the rig's
+  // whole leakage, trended over windows; whether it changed is the change
+  // detector's question over many windows, not one window's gates.
+  bool calibration_only = false;
   std::ostream* progress = nullptr;  // stderr in the program
 };
 

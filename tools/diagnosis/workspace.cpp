@@ -29,7 +29,10 @@ Workspace::Workspace(const RigModel& m, const DiagnoseOptions& o)
     : model(m), options(o), effects(m.effects()), t0_(std::chrono::steady_clock::now()) {
   specs = model.baseline();
   n_base = specs.size();
-  for (auto& sp : specs) hold_within_cause_band(sp);
+  // Trending (calibration only): a parameter that stands for a cause is the
+  // trend's quantity itself, so its whole departure is fitted.
+  if (!o.calibration_only)
+    for (auto& sp : specs) hold_within_cause_band(sp);
   for (const auto& e : effects) {
     offset.push_back(specs.size());
     for (const auto& p : e.params) specs.push_back(p);

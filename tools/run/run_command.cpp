@@ -27,6 +27,7 @@
 #include "foxglove/telemetry/telemetry_server.hpp"
 #include "tools/run/rig_parameters.hpp"
 #include "tools/run/rig_assembly.hpp"
+#include "tools/run/run_catalog.hpp"
 #include "tools/run/service_notify.hpp"
 
 namespace rigctl {
@@ -318,6 +319,12 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
   };
 
   print_run_header(config, options, length, meta, url, foxglove_server.get(), receiver.get(), out);
+  // Entered before the loop, completed after it: a killed run stays in the catalog.
+  RunCatalogEntry catalog_entry(
+      config,
+      RunCatalogContext{run_catalog_path(config, options.catalog_path), options.config_path, options.case_name,
+                        static_cast<bool>(options.profile_override)},
+      report.log_path, meta.start_utime, out);
 
   MonotonicClock monotonic;
   VirtualClock virtual_clock;
@@ -349,6 +356,7 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
       result = loop.run(stop);
     } catch (...) {
       stop_services("control loop failed");
+      catalog_entry.finish(catalog::EndReason::kFaulted, "control loop failed");
       throw;
     }
   }
@@ -360,6 +368,13 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
 
   print_run_summary(config, options, report, *rig.driver, out);
   print_run_records(report, publisher, events, receiver.get(), foxglove_server.get(), out);
+  // A signal's stop is the operator's interruption; a trip that held or
+  // stopped the rig made it faulted (rt/loop/rig_loop.cpp finish_run).
+  catalog_entry.finish(result.final_state == RigState::kFaulted ? catalog::EndReason::kFaulted
+                       : stop.load()                            ? catalog::EndReason::kInterrupted
+                                                                : catalog::EndReason::kCompleted,
+                       report.end_reason);
+  report.catalog_run_id = catalog_entry.id();
   if (!report.csv_path.empty()) {
     const auto csv =
         log_to_csv(report.log_path, report.csv_path, config.telemetry.channel_prefix, options.csv_truth_channels);

@@ -32,6 +32,7 @@ struct RunOptions {
   std::string log_path;              // default: <log_dir>/<rig>-<time>.lcm
   std::string events_path;           // event log; default: <log_path>.events
   std::string csv_path;              // optional run-file CSV
+  std::string catalog_path;          // --catalog: the run catalog, over the config's catalog.path (docs/rig-health.md)
   bool csv_truth_channels = true;    // the simulator's sim_* channels in the CSV too
   std::string lcm_url;               // overrides telemetry.lcm_url
   bool realtime = true;              // false: skip mlockall/SCHED_FIFO (tests)
@@ -63,6 +64,7 @@ struct RunReport {
   std::string log_path;
   std::string csv_path;
   std::string events_path;
+  int64_t catalog_run_id = 0;  // the run's id in the catalog, 0: not entered
   std::string end_reason;  // why the run ended, e.g. "sensor_stuck: x_r = 0.0348"
   double wall_s = 0.0;
 };

@@ -13,6 +13,7 @@ packages=(cmake g++ make pkg-config liblcm-dev liblcm-bin libglib2.0-dev libmodb
           libboost-dev libbenchmark-dev rt-tests iproute2 socat
           libssl-dev   # libssl-dev: libcrypto HMAC-SHA256 for operator commands
           libsystemd-dev   # sd_notify: the service's readiness and watchdog (docs/deployment.md)
+          libsqlite3-dev   # the run catalog of each rig PC: one SQLite file, no server (docs/rig-health.md)
           systemd          # systemd-analyze: tests/system/test_systemd_units.cpp scores the units' hardening
           # The Foxglove WebSocket server (foxglove/server): websocketpp, the
           # maintained header-only WebSocket library Debian ships, on

@@ -53,6 +53,19 @@ TEST(RigConfig, OutOfRange) {
                {"plant.bearing_friction.construction_angle_deg", "got 95"});
 }
 
+// The run catalog's section is optional and read strictly (docs/rig-health.md 1).
+TEST(RigConfig, CatalogSectionIsOptionalAndStrict) {
+  EXPECT_FALSE(parse_rig_config(shipped_config(), "ok.yaml").catalog);
+  const std::string with = shipped_config() + "\ncatalog:\n  path: runs/catalog.sqlite\n  rig_name: qc-3\n";
+  const auto c = parse_rig_config(with, "ok.yaml");
+  ASSERT_TRUE(c.catalog);
+  EXPECT_EQ(c.catalog->path, "runs/catalog.sqlite");
+  EXPECT_EQ(c.catalog->rig_name, "qc-3");
+  EXPECT_EQ(parse_rig_config(shipped_config() + "\ncatalog:\n  path: c.sqlite\n", "ok.yaml").catalog->rig_name, "");
+  expect_config_error(shipped_config() + "\ncatalog:\n  path: c.sqlite\n  rig: qc-3\n", {"bad.yaml:", "catalog.rig", "unknown key"});
+  expect_config_error(shipped_config() + "\ncatalog:\n  rig_name: qc-3\n", {"bad.yaml:", "catalog.path", "missing required key"});
+}
+
 // The PI's velocity feedforward is optional (a tuned config has it) and
 // checked like every gain.
 TEST(RigConfig, VelocityFeedforwardIsOptionalAndChecked) {
