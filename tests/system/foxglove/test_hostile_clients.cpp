@@ -17,6 +17,7 @@
 #include <regex>
 #include <sstream>
 #include <string>
+#include <thread>
 
 #include "background_process.hpp"
 #include "config_edit.hpp"
@@ -46,6 +47,23 @@ int count_lines(const std::string& text, const std::string& fragment) {
   return n;
 }
 
+// Open file descriptors of a process.
+std::size_t open_fds(pid_t pid) {
+  std::size_t n = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator("/proc/" + std::to_string(pid) + "/fd")) ++n;
+  return n;
+}
+
+// Once the server has closed every connection of a round: as many
+// descriptors open as before it (a deadline only for what never happens).
+bool wait_for_fds(pid_t pid, std::size_t baseline) {
+  for (int i = 0; i < 6000; ++i) {
+    if (open_fds(pid) <= baseline) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return false;
+}
+
 // VmRSS of a process [kB].
 long rss_kb(pid_t pid) {
   std::ifstream in("/proc/" + std::to_string(pid) + "/status");
@@ -69,11 +87,11 @@ class HostileClients : public ::testing::Test {
 
   // The shipped quarter car, paced, its overrun detector only indicating,
   // its steps held long, with `websocket` as the telemetry's server.
-  void write_config(const std::string& websocket, const std::string& extra = "") {
-    std::ofstream(path("quarter_car.yaml"))
-        << edit(edit(without_overrun_stop(shipped_config()), "step_hold_s: 4\\.0", "step_hold_s: 60.0"),
-                "(  log_dir: runs[^\n]*\n)", "$1  websocket: " + websocket + "\n")
-        << extra;
+  void write_config(const std::string& websocket, double staleness_s = 2.0) {
+    std::string text = edit(without_overrun_stop(shipped_config()), "step_hold_s: 4\\.0", "step_hold_s: 60.0");
+    text = edit(text, "(  log_dir: runs[^\n]*\n)", "$1  websocket: " + websocket + "\n");
+    text = edit(text, "key_file: operator\\.key", "key_file: rig.key");
+    std::ofstream(path("quarter_car.yaml")) << edit(text, "staleness_s: 2\\.0", "staleness_s: " + std::to_string(staleness_s));
   }
 
   std::unique_ptr<BackgroundProcess> start_rig(int port, const std::vector<std::string>& extra, const std::string& name = "run") {
@@ -187,14 +205,17 @@ TEST_F(HostileClients, MemoryReturnsAfterRoundsOfConnectFloodDisconnect) {
   write_config("{port: 8765}");
   const int port = free_tcp_port();
   auto rig = start_rig(port, {"--duration", "600"});
+  const std::size_t fds = open_fds(rig->pid());
   // One round first: the server thread's allocator arena and the
   // connection objects' pools are made once, not per client.
   run_node("flood-round", port, {"--clients", "15"});
+  ASSERT_TRUE(wait_for_fds(rig->pid(), fds));
   const long start = rss_kb(rig->pid());
   std::vector<long> after;
   for (int round = 0; round < 10; ++round) {
     const auto r = run_node("flood-round", port, {"--clients", "15"});
     ASSERT_FALSE(r.contains("error")) << r.dump(2);
+    ASSERT_TRUE(wait_for_fds(rig->pid(), fds)) << "round " << round << ": connections still open";
     after.push_back(rss_kb(rig->pid()));
   }
   rig->stop();
@@ -207,22 +228,23 @@ TEST_F(HostileClients, MemoryReturnsAfterRoundsOfConnectFloodDisconnect) {
 
 TEST_F(HostileClients, ACommandReplayedIntoARestartedProcessIsRefused) {
   // A staleness window of 60 s, so that only the restart can refuse the replay.
-  write_config("{port: 8765}", "operator:\n  key_file: rig.key\n  staleness_s: 60\n");
+  write_config("{port: 8765}", 60.0);
   const int port = free_tcp_port();
-  const auto key = rigctl::OperatorKey::from_bytes(key_bytes().data(), 32);
-  auto claim = command("take_control", 1, 0.0, rigctl::wall_utime_now(), "mallory");
-  auto reset = command("reset", 2, 0.0, rigctl::wall_utime_now(), "mallory");
-  std::ofstream payloads(path("captured.jsonl"));
-  for (auto* m : {&claim, &reset}) {
-    rigctl::sign(*m, key);
-    payloads << nlohmann::json{{"id", m->sequence}, {"sender", m->sender}, {"sequence", m->sequence}, {"utime", m->utime},
-                               {"command", m->command}, {"value", 0.0}, {"tag", hex(m->tag, 32)}}
-                    .dump()
-             << "\n";
-  }
-  payloads.close();
   {
     auto first = start_rig(port, {"--operator"}, "first");
+    // Signed once the first process runs; captured on their way to it.
+    const auto key = rigctl::OperatorKey::from_bytes(key_bytes().data(), 32);
+    auto claim = command("take_control", 1, 0.0, rigctl::wall_utime_now(), "mallory");
+    auto reset = command("reset", 2, 0.0, rigctl::wall_utime_now(), "mallory");
+    std::ofstream payloads(path("captured.jsonl"));
+    for (auto* m : {&claim, &reset}) {
+      rigctl::sign(*m, key);
+      payloads << nlohmann::json{{"id", m->sequence}, {"sender", m->sender}, {"sequence", m->sequence}, {"utime", m->utime},
+                                 {"command", m->command}, {"value", 0.0}, {"tag", hex(m->tag, 32)}}
+                      .dump()
+               << "\n";
+    }
+    payloads.close();
     const auto r = run_node("send", port, {"--payloads", path("captured.jsonl")});
     EXPECT_EQ(r["answers"][0]["reason"], "accepted") << r;
     EXPECT_EQ(r["answers"][1]["reason"], "accepted") << r;
