@@ -87,7 +87,11 @@ ConsoleGateway::Answer ConsoleGateway::handle(uint64_t client, const std::string
     const json j = json::parse(payload);
     if (j.contains("id") && j["id"].is_number()) a.id = j["id"].get<double>();
     a.command = clip(j.at("command").get<std::string>(), kMaxCommandNameLength);
-    if (a.command == "release_control") return release(client);
+    if (a.command == "release_control") {
+      Answer r = release(client);
+      r.id = a.id;
+      return r;
+    }
     msg = read_command(j);
     a.sequence = msg.sequence;
   } catch (const std::exception& e) {
