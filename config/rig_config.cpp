@@ -3,6 +3,7 @@
 #include <arpa/inet.h>
 
 #include <filesystem>
+#include <stdexcept>
 
 #include "config/config_reader.hpp"
 #include "config/canopen_reader.hpp"
@@ -49,6 +50,19 @@ WebsocketConfig read_websocket(ConfigReader r) {
   }
   c.port = static_cast<int>(r.integer("port", 0, 65535));
   if (r.has("client_queue")) c.client_queue_messages = static_cast<int>(r.integer("client_queue", 1, 1'000'000));
+  if (r.has("max_clients")) c.max_clients = static_cast<int>(r.integer("max_clients", 1, 256));
+  if (r.has("allowed_origins")) {
+    c.allowed_origins = r.texts("allowed_origins", [](const std::string& o) {
+      const auto scheme = o.find("://");
+      const std::string s = scheme == std::string::npos ? "" : o.substr(0, scheme);
+      const std::string host = scheme == std::string::npos ? "" : o.substr(scheme + 3);
+      if ((s != "http" && s != "https") || host.empty() || host.find_first_of("/?#@ ") != std::string::npos) {
+        throw std::invalid_argument("'" + o + "' is not an origin: scheme://host[:port], no path (e.g. https://rig1.lab.example)");
+      }
+    });
+  }
+  if (r.has("control_timeout_s")) c.control_timeout_s = r.number("control_timeout_s", 0.1, 60.0);
+  if (r.has("client_timeout_s")) c.client_timeout_s = r.number("client_timeout_s", 0.5, 3600.0);
   r.reject_unknown_keys();
   return c;
 }

@@ -45,6 +45,18 @@ struct WebsocketConfig {
   std::string address = "127.0.0.1";  // loopback: another address only when the config says so
   int port = 8765;                    // Foxglove's default; 0: any free port
   int client_queue_messages = 1024;   // per client, oldest dropped when full (foxglove/server/server.hpp)
+  int max_clients = 16;               // WebSocket clients at once; the next is refused with HTTP 503
+  std::vector<std::string> allowed_origins;  // pages of these origins may connect besides the server's own (a reverse proxy's)
+  // Control held by a console that has answered no ping for this long is
+  // released. 3 s: three ping intervals, so one late pong on a busy network
+  // keeps control, while a closed laptop or a pulled cable frees it before
+  // an operator at another station has walked over (stop and hold never
+  // need control).
+  double control_timeout_s = 3.0;
+  // A client that has answered no ping for this long is closed: long enough
+  // for a client to ride out a network hiccup, short enough that a vanished
+  // peer or a half-sent frame does not keep its connection for long.
+  double client_timeout_s = 10.0;
 };
 
 struct TelemetryConfig {

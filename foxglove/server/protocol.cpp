@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <stdexcept>
 #include <iterator>
 
 #include <nlohmann/json.hpp>
@@ -9,6 +10,13 @@
 namespace rigctl::foxglove {
 
 using nlohmann::json;
+
+// Every message's text: a client's bytes quoted in it (a parse error, a
+// topic) may be invalid UTF-8, which nlohmann's dump() throws on by
+// default; such bytes become U+FFFD instead.
+namespace {
+std::string to_text(const json& j) { return j.dump(-1, ' ', false, json::error_handler_t::replace); }
+}  // namespace
 
 std::string server_info_json(const std::string& name, const std::map<std::string, std::string>& metadata,
                              const std::string& session_id, bool client_publish) {
@@ -22,7 +30,7 @@ std::string server_info_json(const std::string& name, const std::map<std::string
     out["supportedEncodings"] = json::array({"json"});
   }
   out["capabilities"] = capabilities;
-  return out.dump();
+  return to_text(out);
 }
 
 std::string advertise_json(const std::vector<AdvertisedChannel>& channels) {
@@ -35,15 +43,15 @@ std::string advertise_json(const std::vector<AdvertisedChannel>& channels) {
                     {"schema", c.schema},
                     {"schemaEncoding", "jsonschema"}});
   }
-  return json{{"op", "advertise"}, {"channels", list}}.dump();
+  return to_text(json{{"op", "advertise"}, {"channels", list}});
 }
 
 std::string status_json(const std::string& id, StatusLevel level, const std::string& message) {
-  return json{{"op", "status"}, {"level", static_cast<int>(level)}, {"message", message}, {"id", id}}.dump();
+  return to_text(json{{"op", "status"}, {"level", static_cast<int>(level)}, {"message", message}, {"id", id}});
 }
 
 std::string remove_status_json(const std::vector<std::string>& ids) {
-  return json{{"op", "removeStatus"}, {"statusIds", ids}}.dump();
+  return to_text(json{{"op", "removeStatus"}, {"statusIds", ids}});
 }
 
 std::string parameter_values_json(const std::vector<Parameter>& parameters, const std::string& request_id) {
@@ -51,7 +59,7 @@ std::string parameter_values_json(const std::vector<Parameter>& parameters, cons
   for (const auto& p : parameters) list.push_back({{"name", p.name}, {"value", p.value}, {"type", "float64"}});
   json out{{"op", "parameterValues"}, {"parameters", list}};
   if (!request_id.empty()) out["id"] = request_id;
-  return out.dump();
+  return to_text(out);
 }
 
 namespace {
@@ -61,17 +69,31 @@ void put_le(std::string& out, T v) {
   for (std::size_t i = 0; i < sizeof(T); ++i) out.push_back(static_cast<char>((v >> (8 * i)) & 0xFF));
 }
 
+// An id of the protocol: an integer in the uint32 range, or a request the
+// server refuses (2^40 must not become 0, nor -1 become 4294967295).
+uint32_t uint32_field(const json& j, const char* name) {
+  const json& v = j.at(name);
+  const bool in_range = v.is_number_unsigned() ? v.get<uint64_t>() <= UINT32_MAX
+                                               : v.is_number_integer() && v.get<int64_t>() >= 0 && v.get<int64_t>() <= UINT32_MAX;
+  if (!in_range) throw std::invalid_argument(std::string("'") + name + "' must be an integer in 0..4294967295, not " + clip(to_text(v), 40));
+  return static_cast<uint32_t>(v.get<uint64_t>());
+}
+
+uint32_t uint32_value(const json& v, const char* what) {
+  return uint32_field(json{{what, v}}, what);
+}
+
 ClientRequest read_request(const json& j) {
   ClientRequest r;
-  r.op = j.at("op").get<std::string>();
+  r.op = clip(j.at("op").get<std::string>(), 64);
   if (r.op == "subscribe") {
     r.kind = ClientRequest::Kind::kSubscribe;
     for (const auto& s : j.at("subscriptions")) {
-      r.subscriptions.emplace_back(s.at("id").get<uint32_t>(), s.at("channelId").get<uint32_t>());
+      r.subscriptions.emplace_back(uint32_field(s, "id"), uint32_field(s, "channelId"));
     }
   } else if (r.op == "unsubscribe") {
     r.kind = ClientRequest::Kind::kUnsubscribe;
-    for (const auto& id : j.at("subscriptionIds")) r.unsubscriptions.push_back(id.get<uint32_t>());
+    for (const auto& id : j.at("subscriptionIds")) r.unsubscriptions.push_back(uint32_value(id, "subscriptionIds"));
   } else if (r.op == "getParameters" || r.op == "setParameters") {
     r.kind = r.op == "getParameters" ? ClientRequest::Kind::kGetParameters : ClientRequest::Kind::kSetParameters;
     if (j.contains("id") && j["id"].is_string()) r.request_id = j["id"].get<std::string>();
@@ -84,12 +106,12 @@ ClientRequest read_request(const json& j) {
   } else if (r.op == "advertise") {
     r.kind = ClientRequest::Kind::kAdvertise;
     for (const auto& c : j.at("channels")) {
-      r.client_channels.push_back({c.at("id").get<uint32_t>(), c.at("topic").get<std::string>(),
+      r.client_channels.push_back({uint32_field(c, "id"), c.at("topic").get<std::string>(),
                                    c.at("encoding").get<std::string>(), c.value("schemaName", std::string())});
     }
   } else if (r.op == "unadvertise") {
     r.kind = ClientRequest::Kind::kUnadvertise;
-    for (const auto& id : j.at("channelIds")) r.unadvertised.push_back(id.get<uint32_t>());
+    for (const auto& id : j.at("channelIds")) r.unadvertised.push_back(uint32_value(id, "channelIds"));
   } else if (r.op == "subscribeParameterUpdates" ||
              r.op == "unsubscribeParameterUpdates" || r.op == "subscribeConnectionGraph" ||
              r.op == "unsubscribeConnectionGraph" || r.op == "fetchAsset") {
@@ -99,6 +121,13 @@ ClientRequest read_request(const json& j) {
 }
 
 }  // namespace
+
+std::string clip(const std::string& text, std::size_t max_chars) {
+  if (text.size() <= max_chars) return text;
+  std::size_t n = max_chars;
+  while (n > 0 && (static_cast<unsigned char>(text[n]) & 0xC0) == 0x80) --n;  // not inside a UTF-8 character
+  return text.substr(0, n) + "...";
+}
 
 std::string message_data_frame(uint32_t subscription, uint64_t log_time_ns, const std::string& payload) {
   std::string out;
@@ -116,7 +145,7 @@ ClientRequest parse_client_request(const std::string& text) {
     return read_request(j);
   } catch (const std::exception& e) {
     ClientRequest r;
-    r.error = e.what();
+    r.error = clip(e.what(), kMaxEchoedChars);  // a parse error quotes the client's text
     return r;
   }
 }

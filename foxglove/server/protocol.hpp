@@ -3,6 +3,7 @@
 // client sends. Pure functions, no sockets (docs/foxglove.md).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <map>
 #include <optional>
@@ -38,10 +39,18 @@ std::string remove_status_json(const std::vector<std::string>& ids);
 // parameterValues; request_id "" leaves out `id`.
 std::string parameter_values_json(const std::vector<Parameter>& parameters, const std::string& request_id);
 
+// What the server echoes of a client's text (an op, a topic, a parse error
+// quoting the input) is cut to this many bytes: a client's 30 MB string must
+// not come back as a 30 MB status.
+inline constexpr std::size_t kMaxEchoedChars = 200;
+// `text` cut to at most max_chars bytes (not inside a UTF-8 character), "..." added when cut.
+std::string clip(const std::string& text, std::size_t max_chars);
+
 // Binary opcode 0x01: subscription id, receive (log) time, payload; little endian.
 std::string message_data_frame(uint32_t subscription, uint64_t log_time_ns, const std::string& payload);
 
-// What a client asked for, parsed from one text message.
+// What a client asked for, parsed from one text message. Ids must be
+// integers in the uint32 range (else kUnknown with the error naming the field).
 struct ClientRequest {
   enum class Kind { kSubscribe, kUnsubscribe, kGetParameters, kSetParameters, kAdvertise, kUnadvertise, kRefused, kUnknown };
   Kind kind = Kind::kUnknown;

@@ -1,20 +1,29 @@
-// The Foxglove WebSocket server on websocketpp with standalone asio. Every
-// socket operation runs on the server's one thread; other threads only queue
-// (under the mutex) and post a flush.
+// The Foxglove WebSocket server on websocketpp with standalone asio: the
+// sockets, the handshake's checks, the timers. What a client's messages do
+// is sessions.cpp's. Every socket operation and every map below runs on the
+// server's one thread; other threads only reach the sessions (under their
+// mutex).
 #include "foxglove/server/server.hpp"
+
+#include <malloc.h>
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <deque>
+#include <map>
 #include <mutex>
+#include <optional>
+#include <set>
 #include <stdexcept>
 #include <thread>
 
 #include <websocketpp/config/asio_no_tls.hpp>
 #include <websocketpp/server.hpp>
 
-#include "foxglove/server/client_queue.hpp"
+#include "foxglove/server/origin_policy.hpp"
 #include "foxglove/server/protocol.hpp"
+#include "foxglove/server/sessions.hpp"
 
 namespace rigctl::foxglove {
 
@@ -22,11 +31,12 @@ namespace {
 
 using WsServer = websocketpp::server<websocketpp::config::asio>;
 using Hdl = websocketpp::connection_hdl;
+using Clock = std::chrono::steady_clock;
 
 // Bytes a client's socket may have queued in websocketpp before the server
 // stops handing it more: about a quarter second of every channel at 400 Hz.
 // Past it the client is not keeping up and its messages wait in its own
-// bounded queue, which drops the oldest.
+// bounded queue, which drops the oldest data.
 constexpr std::size_t kMaxSocketBacklog = 256 * 1024;
 // The kernel's share of a client's backlog (it doubles the value): with
 // websocketpp's share above and the client's own queue, a client that stops
@@ -36,6 +46,21 @@ constexpr std::size_t kMaxSocketBacklog = 256 * 1024;
 constexpr int kSocketSendBuffer = 128 * 1024;
 // A client that does not answer the close handshake is not waited for longer.
 constexpr long kCloseTimeoutMs = 1000;
+// A connection that has not completed its HTTP request (a page or an
+// upgrade) in this time is closed: a browser sends it at once.
+constexpr long kOpenHandshakeTimeoutMs = 5000;
+// Connections still in their HTTP request at once. Past it the oldest is
+// closed to make room, so a flood of idle connections cannot lock a
+// console out (a console's request completes within milliseconds of its
+// connect) and the process keeps file descriptors to spare. 64: a browser
+// opens up to 6 per host for a page's files, times a control room's
+// consoles reconnecting together, with room.
+constexpr std::size_t kMaxPendingConnections = 64;
+// The body of a plain HTTP request: only GETs are answered.
+constexpr std::size_t kMaxHttpBodyBytes = 1024;
+// After a failed accept (out of file descriptors) the next waits this
+// long rather than retrying at once, which would spin.
+constexpr auto kAcceptRetry = std::chrono::milliseconds(100);
 // How often the clients' queues go onto their sockets. Every 5 ms is two
 // ticks of every channel per write at 400 Hz: a fraction of the wake-ups of
 // the server, the clients and the kernel's loopback that a write per message
@@ -44,16 +69,6 @@ constexpr long kCloseTimeoutMs = 1000;
 // again at the next flush.
 constexpr auto kFlushInterval = std::chrono::milliseconds(5);
 
-struct Client {
-  Client(uint64_t i, Hdl h, std::size_t capacity) : id(i), hdl(std::move(h)), queue(capacity) {}
-  uint64_t id;
-  Hdl hdl;
-  std::map<uint32_t, uint32_t> subscription_of_channel;
-  std::map<uint32_t, ClientChannel> advertised;  // the client's own channels (clientPublish)
-  ClientQueue queue;
-  ClientStats stats;
-};
-
 }  // namespace
 
 struct Server::Impl {
@@ -61,50 +76,44 @@ struct Server::Impl {
   WsServer ws;
   std::thread thread;
   uint16_t port = 0;
-  std::string session_id;
-  std::unique_ptr<asio::steady_timer> flush_timer;
-  HttpHandler http;                                  // set before start()
-  ClientPublishHandler* publish_handler = nullptr;   // likewise
-  std::vector<std::string> publish_topics;
+  Sessions sessions;
+  std::optional<OriginPolicy> origins;  // once the port is known
+  std::unique_ptr<asio::steady_timer> flush_timer, ping_timer, accept_timer;
+  HttpHandler http;  // set before start()
+  bool stopped = false;  // under stop_mu
+  std::mutex stop_mu;
+  std::atomic<bool> stopping{false};  // the timers must not re-arm once set
 
-  mutable std::mutex mu;  // everything below
-  std::map<Hdl, std::shared_ptr<Client>, std::owner_less<Hdl>> clients;
-  std::vector<std::shared_ptr<Client>> seen;  // for the statistics, closed ones too
-  std::vector<AdvertisedChannel> channels;
-  std::map<std::string, std::pair<StatusLevel, std::string>> statuses;
-  std::vector<Parameter> parameters;
-  uint64_t next_client_id = 1;
-  bool stopped = false;
-  std::atomic<bool> stopping{false};  // the flush timer must not re-arm once set
+  // The server's thread only.
+  std::map<Hdl, uint64_t, std::owner_less<Hdl>> id_of;
+  std::map<uint64_t, Hdl> hdl_of;
+  std::map<uint64_t, Clock::time_point> last_pong;
+  std::map<Hdl, bool, std::owner_less<Hdl>> admitted;  // upgrades accepted, until closed
+  std::set<uint64_t> closing;                           // closed by the server, not yet gone
+  std::deque<std::weak_ptr<WsServer::connection_type>> pending;
 
-  explicit Impl(ServerOptions o) : options(std::move(o)) {}
+  Impl(ServerOptions o, SessionsOptions so) : options(std::move(o)), sessions(std::move(so)) {}
 
-  std::shared_ptr<Client> client(const Hdl& hdl) {
-    std::lock_guard<std::mutex> lock(mu);
-    const auto it = clients.find(hdl);
-    return it == clients.end() ? nullptr : it->second;
-  }
+  static std::string peer(const WsServer::connection_ptr& con) { return con->get_remote_endpoint(); }
 
-  void send_text(const Hdl& hdl, const std::string& text) {
-    websocketpp::lib::error_code ec;
-    ws.send(hdl, text, websocketpp::frame::opcode::text, ec);  // a closing connection: nothing to do
-  }
-
-  void send_to_all(const std::string& text) {
-    std::vector<Hdl> hdls;
-    {
-      std::lock_guard<std::mutex> lock(mu);
-      for (const auto& [hdl, c] : clients) hdls.push_back(hdl);
-    }
-    for (const auto& hdl : hdls) send_text(hdl, text);
-  }
-
-  void post_to_all(std::string text) {
-    asio::post(ws.get_io_service(), [this, text = std::move(text)] { send_to_all(text); });
-  }
-
+  // An upgrade: this server's Host and Origin, a free client slot, a subprotocol it speaks.
   bool validate(const Hdl& hdl) {
     auto con = ws.get_con_from_hdl(hdl);
+    const std::string why = origins->check(con->get_request_header("Host"), con->get_request_header("Origin"));
+    if (!why.empty()) {
+      sessions.refuse("origin", "upgrade from " + peer(con) + " refused (403): " + why);
+      con->set_status(websocketpp::http::status_code::forbidden);
+      con->set_body(why + "\n");
+      return false;
+    }
+    if (admitted.size() >= options.max_clients) {
+      sessions.refuse("too_many_clients", "upgrade from " + peer(con) + " refused (503): " +
+                                              std::to_string(options.max_clients) + " clients connected");
+      con->set_status(websocketpp::http::status_code::service_unavailable);
+      con->set_body("rigctl serves at most " + std::to_string(options.max_clients) +
+                    " clients at once (telemetry.websocket.max_clients); close one and connect again\n");
+      return false;
+    }
     const auto chosen = choose_subprotocol(con->get_requested_subprotocols());
     if (!chosen) {
       con->set_status(websocketpp::http::status_code::bad_request);
@@ -112,170 +121,62 @@ struct Server::Impl {
       return false;
     }
     con->select_subprotocol(*chosen);
+    admitted[hdl] = true;
     return true;
   }
 
   void on_open(const Hdl& hdl) {
     auto con = ws.get_con_from_hdl(hdl);
-    std::vector<std::string> greeting{
-        server_info_json(options.name, options.metadata, session_id, publish_handler != nullptr)};
-    {
-      std::lock_guard<std::mutex> lock(mu);
-      auto c = std::make_shared<Client>(next_client_id++, hdl, options.client_queue_messages);
-      c->stats.address = con->get_remote_endpoint();
-      c->stats.subprotocol = con->get_subprotocol();
-      clients.emplace(hdl, c);
-      seen.push_back(c);
-      greeting.push_back(advertise_json(channels));
-      for (const auto& [id, status] : statuses) greeting.push_back(status_json(id, status.first, status.second));
-    }
-    for (const auto& text : greeting) send_text(hdl, text);
+    const uint64_t id = sessions.open(peer(con), con->get_subprotocol());
+    id_of[hdl] = id;
+    hdl_of[id] = hdl;
+    last_pong[id] = Clock::now();
+    flush_one(id, hdl);  // the greeting at once
   }
 
   void on_close(const Hdl& hdl) {
-    std::shared_ptr<Client> gone;
-    {
-      std::lock_guard<std::mutex> lock(mu);
-      const auto it = clients.find(hdl);
-      if (it == clients.end()) return;  // a handshake that failed: never opened
-      gone = it->second;
-      clients.erase(it);
+    admitted.erase(hdl);
+    const auto it = id_of.find(hdl);
+    if (it == id_of.end()) return;  // a handshake that failed: never opened
+    const uint64_t id = it->second;
+    websocketpp::lib::error_code ec;
+    auto con = ws.get_con_from_hdl(hdl, ec);
+    if (!ec && con->get_local_close_code() == websocketpp::close::status::message_too_big) {
+      sessions.refuse("message_too_big", "client " + sessions.address(id) + " closed: a message over " +
+                                             std::to_string(kMaxMessageBytes / 1024) + " kB");
     }
-    if (publish_handler != nullptr) publish_handler->on_client_closed(gone->id);
+    id_of.erase(it);
+    hdl_of.erase(id);
+    last_pong.erase(id);
+    closing.erase(id);
+    sessions.close(id);
+    // Give the freed queue (up to kMaxClientQueueBytes) and buffers back
+    // to the system: glibc keeps freed memory in the thread's arena
+    // otherwise, and a process that served a flood would stay at its high
+    // water mark. Closes are rare; the trim takes well under a millisecond
+    // and the loop, which never allocates, does not wait for it.
+    ::malloc_trim(0);
   }
 
-  // A binary frame: a message on a channel the client advertised, handed to
-  // the publish handler; anything else is answered with a warning.
-  void on_client_data(const Hdl& hdl, const Client& c, const std::string& frame) {
-    const auto data = parse_client_message_data(frame);
-    if (!data) {
-      send_text(hdl, status_json("bad_client_message", StatusLevel::kWarning,
-                                 "unreadable binary message: only opcode 1 (client message data) is accepted"));
-      return;
-    }
-    std::string topic;
-    {
-      std::lock_guard<std::mutex> lock(mu);
-      const auto it = c.advertised.find(data->channel);
-      if (it != c.advertised.end()) topic = it->second.topic;
-    }
-    if (topic.empty() || publish_handler == nullptr) {
-      send_text(hdl, status_json("bad_client_message", StatusLevel::kWarning,
-                                 "client channel " + std::to_string(data->channel) + " was not advertised"));
-      return;
-    }
-    publish_handler->on_client_message(c.id, topic, data->payload);
-  }
-
-  // Client channels: JSON on one of the accepted topics, or refused.
-  void on_advertise(const Hdl& hdl, Client& c, const ClientRequest& r) {
-    for (const auto& ch : r.client_channels) {
-      const bool topic_ok = std::find(publish_topics.begin(), publish_topics.end(), ch.topic) != publish_topics.end();
-      if (publish_handler == nullptr || !topic_ok || ch.encoding != "json") {
-        send_text(hdl, status_json("refused_advertise", StatusLevel::kWarning,
-                                   publish_handler == nullptr
-                                       ? "rigctl serves read-only telemetry here: client publishing is not offered"
-                                       : "client channel '" + ch.topic + "' (" + ch.encoding +
-                                             ") refused: only JSON on the console's command topic"));
-        continue;
-      }
-      std::lock_guard<std::mutex> lock(mu);
-      c.advertised[ch.id] = ch;
-    }
-  }
-
-  void on_message(const Hdl& hdl, WsServer::message_ptr msg) {
-    auto c = client(hdl);
-    if (!c) return;
-    if (msg->get_opcode() != websocketpp::frame::opcode::text) {
-      on_client_data(hdl, *c, msg->get_payload());
-      return;
-    }
-    const ClientRequest r = parse_client_request(msg->get_payload());
-    switch (r.kind) {
-      case ClientRequest::Kind::kSubscribe: {
-        std::lock_guard<std::mutex> lock(mu);
-        for (const auto& [sub, channel] : r.subscriptions) {
-          if (channel < channels.size() + 1 && channel > 0) c->subscription_of_channel[channel] = sub;
-        }
-        return;
-      }
-      case ClientRequest::Kind::kUnsubscribe: {
-        std::lock_guard<std::mutex> lock(mu);
-        for (const auto sub : r.unsubscriptions) {
-          for (auto it = c->subscription_of_channel.begin(); it != c->subscription_of_channel.end();) {
-            it = it->second == sub ? c->subscription_of_channel.erase(it) : std::next(it);
-          }
-        }
-        return;
-      }
-      case ClientRequest::Kind::kAdvertise:
-        on_advertise(hdl, *c, r);
-        return;
-      case ClientRequest::Kind::kUnadvertise: {
-        std::lock_guard<std::mutex> lock(mu);
-        for (const auto id : r.unadvertised) c->advertised.erase(id);
-        return;
-      }
-      case ClientRequest::Kind::kGetParameters:
-      case ClientRequest::Kind::kSetParameters:
-        answer_parameters(hdl, r);
-        return;
-      case ClientRequest::Kind::kRefused:
-        send_text(hdl, status_json("refused_" + r.op, StatusLevel::kWarning,
-                                   "rigctl serves read-only telemetry: '" + r.op + "' is not offered"));
-        return;
-      case ClientRequest::Kind::kUnknown:
-        send_text(hdl, status_json("bad_request", StatusLevel::kWarning,
-                                   r.error.empty() ? "unknown op '" + r.op + "'" : "unreadable request: " + r.error));
-        return;
-    }
-  }
-
-  void answer_parameters(const Hdl& hdl, const ClientRequest& r) {
-    std::vector<Parameter> answer;
-    {
-      std::lock_guard<std::mutex> lock(mu);
-      for (const auto& p : parameters) {
-        const bool wanted = r.parameter_names.empty() ||
-                            std::find(r.parameter_names.begin(), r.parameter_names.end(), p.name) != r.parameter_names.end();
-        if (wanted) answer.push_back(p);
-      }
-    }
-    if (r.kind == ClientRequest::Kind::kSetParameters) {
-      send_text(hdl, status_json("parameters_read_only", StatusLevel::kWarning,
-                                 "the rig's gains and limits are read-only here: change the rig's config file"));
-    }
-    send_text(hdl, parameter_values_json(answer, r.request_id));
-  }
-
-  // On the server's thread: each client's queue onto its socket while the
-  // socket keeps up.
-  void flush() {
-    std::vector<std::shared_ptr<Client>> open;
-    {
-      std::lock_guard<std::mutex> lock(mu);
-      for (const auto& [hdl, c] : clients) open.push_back(c);
-    }
-    for (const auto& c : open) {
-      websocketpp::lib::error_code ec;
-      auto con = ws.get_con_from_hdl(c->hdl, ec);
-      if (ec || con->get_state() != websocketpp::session::state::open) continue;
-      QueuedMessage m;
-      while (con->get_buffered_amount() < kMaxSocketBacklog) {
-        {
-          std::lock_guard<std::mutex> lock(mu);
-          if (!c->queue.pop(m)) break;
-        }
-        con->send(message_data_frame(m.subscription, m.log_time_ns, *m.payload), websocketpp::frame::opcode::binary);
-        std::lock_guard<std::mutex> lock(mu);
-        ++c->stats.sent;
-      }
+  void on_message(const Hdl& hdl, const WsServer::message_ptr& msg) {
+    const auto it = id_of.find(hdl);
+    if (it == id_of.end()) return;
+    if (msg->get_opcode() == websocketpp::frame::opcode::text) {
+      sessions.handle_text(it->second, msg->get_payload());
+    } else {
+      sessions.handle_binary(it->second, msg->get_payload());
     }
   }
 
   void on_http(const Hdl& hdl) {
     auto con = ws.get_con_from_hdl(hdl);
+    const std::string why = origins->check(con->get_request_header("Host"), con->get_request_header("Origin"));
+    if (!why.empty()) {
+      sessions.refuse("origin", "page request from " + peer(con) + " refused (403): " + why);
+      con->set_status(websocketpp::http::status_code::forbidden);
+      con->set_body(why + "\n");
+      return;
+    }
     if (!http) {
       con->set_status(websocketpp::http::status_code::upgrade_required);
       con->set_body("rigctl speaks the Foxglove WebSocket protocol here\n");
@@ -300,26 +201,156 @@ struct Server::Impl {
     con->set_body(r.body);
   }
 
-  void arm_flush_timer() {
-    flush_timer->expires_after(kFlushInterval);
-    flush_timer->async_wait([this](const asio::error_code& ec) {
+  // One client's queue onto its socket while the socket keeps up.
+  void flush_one(uint64_t id, const Hdl& hdl) {
+    websocketpp::lib::error_code ec;
+    auto con = ws.get_con_from_hdl(hdl, ec);
+    if (ec || con->get_state() != websocketpp::session::state::open) return;
+    QueuedMessage m;
+    while (con->get_buffered_amount() < kMaxSocketBacklog && sessions.pop(id, m)) {
+      if (m.data) {
+        con->send(message_data_frame(m.subscription, m.log_time_ns, *m.payload), websocketpp::frame::opcode::binary);
+      } else {
+        con->send(*m.payload, m.binary ? websocketpp::frame::opcode::binary : websocketpp::frame::opcode::text);
+      }
+    }
+  }
+
+  void flush() {
+    for (const auto& [id, hdl] : hdl_of) {
+      if (closing.count(id) == 0) flush_one(id, hdl);
+    }
+    for (const auto& [id, why] : sessions.take_overflowed()) close_client(id, websocketpp::close::status::policy_violation, why);
+  }
+
+  void close_client(uint64_t id, websocketpp::close::status::value code, const std::string& why) {
+    const auto it = hdl_of.find(id);
+    if (it == hdl_of.end() || !closing.insert(id).second) return;
+    websocketpp::lib::error_code ec;
+    ws.close(it->second, code, clip(why, 100), ec);  // a close reason is at most 123 bytes
+  }
+
+  // Every ping interval: clients silent too long are closed, the rest are
+  // told of their silence (the console releases a silent holder's control)
+  // and pinged.
+  void ping_all() {
+    const auto now = Clock::now();
+    std::vector<std::pair<uint64_t, double>> silent, gone;
+    for (const auto& [id, hdl] : hdl_of) {
+      if (closing.count(id) > 0) continue;
+      const double s = std::chrono::duration<double>(now - last_pong[id]).count();
+      if (s >= options.client_timeout_s) {
+        gone.emplace_back(id, s);
+        continue;
+      }
+      if (s > options.ping_interval_s) silent.emplace_back(id, s);
+      websocketpp::lib::error_code ec;
+      ws.ping(hdl, "", ec);
+    }
+    // After the loop: a close may end the connection at once, and its
+    // handler changes the maps.
+    for (const auto& [id, s] : gone) {
+      sessions.refuse("unresponsive", "client " + sessions.address(id) + " closed: no answer to pings for " +
+                                          std::to_string(static_cast<int>(s)) + " s");
+      close_client(id, websocketpp::close::status::policy_violation, "no answer to pings");
+    }
+    if (ClientPublishHandler* h = sessions.publish_handler()) {
+      for (const auto& [id, s] : silent) h->on_client_silent(id, s);
+    }
+  }
+
+  void on_pong(const Hdl& hdl) {
+    const auto it = id_of.find(hdl);
+    if (it != id_of.end()) last_pong[it->second] = Clock::now();
+  }
+
+  // Our own accept loop, rather than websocketpp's: it backs off after a
+  // failed accept instead of retrying at once, and it bounds the
+  // connections that have not finished their HTTP request.
+  void accept_next() {
+    if (stopping.load()) return;
+    websocketpp::lib::error_code ec;
+    WsServer::connection_ptr con = ws.get_connection();
+    if (!con) return retry_accept("no connection object");
+    ws.async_accept(std::static_pointer_cast<WsServer::transport_con_type>(con),
+                    [this, con](const websocketpp::lib::error_code& e) { on_accept(con, e); }, ec);
+    if (ec) con->terminate(ec);  // not listening any more: stopped
+  }
+
+  void on_accept(const WsServer::connection_ptr& con, const websocketpp::lib::error_code& ec) {
+    if (ec) {
+      con->terminate(ec);
+      if (ec == websocketpp::error::operation_canceled || stopping.load()) return;
+      return retry_accept(ec.message());
+    }
+    bound_pending(con);
+    con->start();
+    accept_next();
+  }
+
+  void retry_accept(const std::string& why) {
+    sessions.refuse("accept_failed", "accepting a connection failed (" + why + "); trying again in 100 ms");
+    accept_timer->expires_after(kAcceptRetry);
+    accept_timer->async_wait([this](const asio::error_code& e) {
+      if (!e) accept_next();
+    });
+  }
+
+  void bound_pending(const WsServer::connection_ptr& con) {
+    std::deque<std::weak_ptr<WsServer::connection_type>> still;
+    for (const auto& w : pending) {
+      const auto p = w.lock();
+      if (p && p->get_state() == websocketpp::session::state::connecting) still.push_back(w);
+    }
+    pending.swap(still);
+    while (pending.size() >= kMaxPendingConnections) {
+      if (const auto oldest = pending.front().lock()) {
+        sessions.refuse("pending_closed", "connection from " + peer(oldest) + " closed before its request: " +
+                                              std::to_string(kMaxPendingConnections) + " connections waiting");
+        asio::error_code e;
+        oldest->get_raw_socket().close(e);  // its pending read fails and websocketpp frees it
+      }
+      pending.pop_front();
+    }
+    pending.push_back(con);
+  }
+
+  void arm(asio::steady_timer& timer, Clock::duration every, void (Impl::*step)()) {
+    timer.expires_after(every);
+    timer.async_wait([this, &timer, every, step](const asio::error_code& ec) {
       // Cancelled, or it fired just as stop() cancelled it: not again, or
       // the server's thread would never run out of work.
       if (ec || stopping.load()) return;
-      flush();
-      arm_flush_timer();
+      (this->*step)();
+      arm(timer, every, step);
     });
   }
 };
 
-Server::Server(ServerOptions options) : impl_(std::make_unique<Impl>(std::move(options))) {
-  Impl& s = *impl_;
+namespace {
+
+SessionsOptions sessions_options(const ServerOptions& o) {
+  SessionsOptions s;
+  s.name = o.name;
+  s.metadata = o.metadata;
   s.session_id = std::to_string(std::chrono::system_clock::now().time_since_epoch().count());
+  s.queue_messages = o.client_queue_messages;
+  return s;
+}
+
+}  // namespace
+
+Server::Server(ServerOptions options) : impl_(std::make_unique<Impl>(options, sessions_options(options))) {
+  Impl& s = *impl_;
   s.ws.clear_access_channels(websocketpp::log::alevel::all);
   s.ws.clear_error_channels(websocketpp::log::elevel::all);
   s.ws.init_asio();
   s.ws.set_reuse_addr(true);
+  s.ws.set_user_agent("rigctl");  // the Server header: no library name or version to look up
   s.ws.set_close_handshake_timeout(kCloseTimeoutMs);
+  s.ws.set_open_handshake_timeout(kOpenHandshakeTimeoutMs);
+  s.ws.set_max_message_size(kMaxMessageBytes);
+  s.ws.set_max_http_body_size(kMaxHttpBodyBytes);
   // After the accept (before it the socket is not open yet).
   s.ws.set_tcp_post_init_handler([&s](Hdl hdl) {
     asio::error_code ec;
@@ -332,15 +363,15 @@ Server::Server(ServerOptions options) : impl_(std::make_unique<Impl>(std::move(o
   s.ws.set_open_handler([&s](Hdl hdl) { s.on_open(hdl); });
   s.ws.set_close_handler([&s](Hdl hdl) { s.on_close(hdl); });
   s.ws.set_fail_handler([&s](Hdl hdl) { s.on_close(hdl); });
-  s.ws.set_message_handler([&s](Hdl hdl, WsServer::message_ptr m) { s.on_message(hdl, std::move(m)); });
+  s.ws.set_message_handler([&s](Hdl hdl, WsServer::message_ptr m) { s.on_message(hdl, m); });
   s.ws.set_http_handler([&s](Hdl hdl) { s.on_http(hdl); });
+  s.ws.set_pong_handler([&s](Hdl hdl, const std::string&) { s.on_pong(hdl); });
   const std::string where = s.options.address + ":" + std::to_string(s.options.port);
   try {
     asio::error_code ec;
     const auto address = asio::ip::make_address(s.options.address, ec);
     if (ec) throw std::runtime_error("'" + s.options.address + "' is not an IP address");
     s.ws.listen(asio::ip::tcp::endpoint(address, s.options.port));
-    s.ws.start_accept();
     const auto local = s.ws.get_local_endpoint(ec);
     if (ec) throw std::runtime_error(ec.message());
     s.port = local.port();
@@ -349,37 +380,38 @@ Server::Server(ServerOptions options) : impl_(std::make_unique<Impl>(std::move(o
   } catch (const std::runtime_error& e) {
     throw std::runtime_error("foxglove server: cannot listen on " + where + ": " + e.what());
   }
-  s.flush_timer = std::make_unique<asio::steady_timer>(s.ws.get_io_service());
+  s.origins.emplace(s.options.address, s.port, s.options.allowed_origins);
+  for (auto* t : {&s.flush_timer, &s.ping_timer, &s.accept_timer}) *t = std::make_unique<asio::steady_timer>(s.ws.get_io_service());
 }
 
 Server::~Server() { stop(); }
 
 void Server::start() {
-  if (impl_->thread.joinable()) return;
-  impl_->arm_flush_timer();
-  impl_->thread = std::thread([this] { impl_->ws.run(); });
+  Impl& s = *impl_;
+  if (s.thread.joinable()) return;
+  s.accept_next();
+  s.arm(*s.flush_timer, kFlushInterval, &Impl::flush);
+  const auto ping = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s.options.ping_interval_s));
+  s.arm(*s.ping_timer, ping, &Impl::ping_all);
+  s.thread = std::thread([&s] { s.ws.run(); });
 }
 
 void Server::stop() {
   Impl& s = *impl_;
   {
-    std::lock_guard<std::mutex> lock(s.mu);
+    std::lock_guard<std::mutex> lock(s.stop_mu);
     if (s.stopped) return;
     s.stopped = true;
   }
   s.stopping.store(true);
   // On the server's thread: stop accepting, close every client, cancel the
-  // timer; run() returns once nothing is left to do.
+  // timers; run() returns once nothing is left to do.
   asio::post(s.ws.get_io_service(), [&s] {
     websocketpp::lib::error_code ec;
     s.ws.stop_listening(ec);
-    s.flush_timer->cancel();
-    std::vector<Hdl> hdls;
-    {
-      std::lock_guard<std::mutex> lock(s.mu);
-      for (const auto& [hdl, c] : s.clients) hdls.push_back(hdl);
-    }
-    for (const auto& hdl : hdls) s.ws.close(hdl, websocketpp::close::status::going_away, "rigctl stops", ec);
+    for (auto* t : {&s.flush_timer, &s.ping_timer, &s.accept_timer}) (*t)->cancel();
+    const auto open = s.hdl_of;  // a close may end a connection at once, and its handler changes the map
+    for (const auto& [id, hdl] : open) s.ws.close(hdl, websocketpp::close::status::going_away, "rigctl stops", ec);
   });
   if (!s.thread.joinable()) return;
   // A client that never answers the close handshake holds run() for the
@@ -391,81 +423,37 @@ uint16_t Server::port() const { return impl_->port; }
 const std::string& Server::address() const { return impl_->options.address; }
 
 uint32_t Server::add_channel(const std::string& topic, const std::string& schema_name, const std::string& schema) {
-  AdvertisedChannel c;
-  {
-    std::lock_guard<std::mutex> lock(impl_->mu);
-    c = AdvertisedChannel{static_cast<uint32_t>(impl_->channels.size() + 1), topic, schema_name, schema};
-    impl_->channels.push_back(c);
-  }
-  impl_->post_to_all(advertise_json({c}));
-  return c.id;
+  return impl_->sessions.add_channel(topic, schema_name, schema);
 }
 
 void Server::set_http_handler(HttpHandler handler) { impl_->http = std::move(handler); }
 
 void Server::accept_client_publish(ClientPublishHandler* handler, std::vector<std::string> topics) {
-  impl_->publish_handler = handler;
-  impl_->publish_topics = std::move(topics);
+  impl_->sessions.accept_client_publish(handler, std::move(topics));
 }
 
-bool Server::has_subscribers(uint32_t channel) const {
-  std::lock_guard<std::mutex> lock(impl_->mu);
-  for (const auto& [hdl, c] : impl_->clients) {
-    if (c->subscription_of_channel.count(channel) > 0) return true;
-  }
-  return false;
-}
+void Server::set_refusal_handler(RefusalHandler handler) { impl_->sessions.refusals().set_handler(std::move(handler)); }
+
+bool Server::has_subscribers(uint32_t channel) const { return impl_->sessions.has_subscribers(channel); }
 
 void Server::publish(uint32_t channel, uint64_t log_time_ns, std::shared_ptr<const std::string> json) {
-  std::lock_guard<std::mutex> lock(impl_->mu);
-  for (const auto& [hdl, c] : impl_->clients) {
-    const auto it = c->subscription_of_channel.find(channel);
-    if (it != c->subscription_of_channel.end()) c->queue.push(QueuedMessage{it->second, log_time_ns, json});
-  }
+  impl_->sessions.publish(channel, log_time_ns, json);
 }
 
 void Server::publish_to(uint64_t client, uint32_t channel, uint64_t log_time_ns, std::shared_ptr<const std::string> json) {
-  std::lock_guard<std::mutex> lock(impl_->mu);
-  for (const auto& [hdl, c] : impl_->clients) {
-    if (c->id != client) continue;
-    const auto it = c->subscription_of_channel.find(channel);
-    if (it != c->subscription_of_channel.end()) c->queue.push(QueuedMessage{it->second, log_time_ns, json});
-  }
+  impl_->sessions.publish_to(client, channel, log_time_ns, std::move(json));
 }
 
 void Server::set_status(const std::string& id, StatusLevel level, const std::string& message) {
-  {
-    std::lock_guard<std::mutex> lock(impl_->mu);
-    impl_->statuses[id] = {level, message};
-  }
-  impl_->post_to_all(status_json(id, level, message));
+  impl_->sessions.set_status(id, level, message);
 }
 
-void Server::remove_status(const std::string& id) {
-  {
-    std::lock_guard<std::mutex> lock(impl_->mu);
-    if (impl_->statuses.erase(id) == 0) return;
-  }
-  impl_->post_to_all(remove_status_json({id}));
-}
+void Server::remove_status(const std::string& id) { impl_->sessions.remove_status(id); }
 
-void Server::set_parameters(std::vector<Parameter> parameters) {
-  std::lock_guard<std::mutex> lock(impl_->mu);
-  impl_->parameters = std::move(parameters);
-}
+void Server::set_parameters(std::vector<Parameter> parameters) { impl_->sessions.set_parameters(std::move(parameters)); }
 
-ServerStats Server::stats() const {
-  std::lock_guard<std::mutex> lock(impl_->mu);
-  ServerStats out;
-  out.clients = static_cast<int64_t>(impl_->seen.size());
-  for (const auto& c : impl_->seen) {
-    ClientStats cs = c->stats;
-    cs.dropped = c->queue.dropped();
-    out.sent += cs.sent;
-    out.dropped += cs.dropped;
-    out.per_client.push_back(cs);
-  }
-  return out;
-}
+ServerStats Server::stats() const { return impl_->sessions.stats(); }
+
+Sessions& Server::sessions() { return impl_->sessions; }
 
 }  // namespace rigctl::foxglove

@@ -14,6 +14,7 @@
 
 #include "foxglove/server/server.hpp"
 #include "foxglove/telemetry/telemetry_feed.hpp"
+#include "rt/comms/event_log.hpp"
 
 namespace rigctl::foxglove {
 
@@ -26,8 +27,12 @@ class TelemetryServer {
   TelemetryServer(const TelemetryServer&) = delete;
   TelemetryServer& operator=(const TelemetryServer&) = delete;
 
-  // Before start(): the console's commands go to `receiver` (operator mode).
-  void enable_console_commands(CommandReceiver& receiver);
+  // Before start(): the server's refusals and the console's control
+  // changes also go into the run's event log (rate-limited).
+  void log_to(EventLog& events);
+  // Before start(): the console's commands go to `intake` (operator mode);
+  // control held by a console silent for control_timeout_s is released.
+  void enable_console_commands(CommandIntake& intake, double control_timeout_s);
 
   void start() { server_.start(); }
   void stop() { server_.stop(); }
@@ -42,6 +47,7 @@ class TelemetryServer {
   Server server_;
   TelemetryFeed feed_;
   std::unique_ptr<ConsoleGateway> console_;
+  EventLog* events_ = nullptr;
 };
 
 }  // namespace rigctl::foxglove

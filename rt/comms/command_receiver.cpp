@@ -25,6 +25,28 @@ std::string regex_literal(const std::string& s) {
   return out;
 }
 
+CommandIntakeOptions intake_options(const CommandReceiverOptions& o) {
+  CommandIntakeOptions i;
+  i.policy = o.policy;
+  // Nothing signed before this receiver started is taken: no replay across a
+  // restart (rt/comms/operator_auth.hpp says why this rather than a
+  // persisted replay table).
+  if (i.policy.not_before_utime == 0) i.policy.not_before_utime = wall_utime_now();
+  i.queue_capacity = o.queue_capacity;
+  i.max_senders = o.max_senders;
+  i.refusal_logs_per_second = o.rejection_logs_per_second;
+  i.on_refusal = [forward = o.on_rejection_logged](const RejectionNote& n) {
+    spdlog::warn("operator commands: {}", n.text);
+    if (forward) forward(n);
+  };
+  i.on_accepted = [](const DecodedCommand& d) {
+    spdlog::info("operator command '{}'{} from '{}' (sequence {}) accepted", to_string(d.command.kind),
+                 d.command.kind == OperatorCommandKind::kSetpoint ? fmt::format(" {:g}", d.command.value) : std::string(),
+                 d.sender, d.sequence);
+  };
+  return i;
+}
+
 }  // namespace
 
 std::string default_command_channel(const std::string& channel_prefix) { return channel_prefix + "OPERATOR"; }
@@ -33,10 +55,7 @@ std::string default_ack_channel(const std::string& command_channel) { return com
 CommandReceiver::CommandReceiver(const CommandReceiverOptions& options)
     : channel_(options.channel),
       ack_channel_(options.ack_channel.empty() ? default_ack_channel(options.channel) : options.ack_channel),
-      logs_per_second_(options.rejection_logs_per_second),
-      on_rejection_logged_(options.on_rejection_logged),
-      verifier_(load_operator_key(options.key_path), options.policy, options.max_senders),
-      queue_(options.queue_capacity) {
+      intake_(load_operator_key(options.key_path), intake_options(options)) {
   if (channel_.empty()) throw std::runtime_error("operator commands: empty command channel name");
   if (channel_ == ack_channel_) throw std::runtime_error("operator commands: command and ack channel are both '" + channel_ + "'");
   // An empty URL would make LCM fall back to its default multicast group.
@@ -78,31 +97,14 @@ void CommandReceiver::run() {
 
 void CommandReceiver::on_message(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
   const int64_t now = wall_utime_now();
-  const DecodedCommand d = accept(rbuf->data, rbuf->data_size, now);
+  const DecodedCommand d = intake_.submit(rbuf->data, rbuf->data_size, now);
   // Nothing to address a reply to when the message did not decode as far as
   // its sender id.
   if (!d.sender.empty() && valid_sender_id(d.sender)) reply(d, now);
 }
 
-DecodedCommand CommandReceiver::submit(const void* data, std::size_t size) { return accept(data, size, wall_utime_now()); }
-
-DecodedCommand CommandReceiver::accept(const void* data, std::size_t size, int64_t now) {
-  std::lock_guard<std::mutex> lock(producer_mu_);
-  DecodedCommand d = verifier_.verify(data, size, now);
-  if (d.ok()) {
-    if (queue_.try_push(d.command)) {
-      spdlog::info("operator command '{}'{} from '{}' (sequence {}) accepted", to_string(d.command.kind),
-                   d.command.kind == OperatorCommandKind::kSetpoint ? fmt::format(" {:g}", d.command.value) : std::string(),
-                   d.sender, d.sequence);
-    } else {
-      // The sequence is used up: the sender must send again with a new one.
-      verifier_.reclassify_accepted(RejectReason::kQueueFull);
-      d.reason = RejectReason::kQueueFull;
-      d.detail = "the loop has not taken the last " + std::to_string(queue_.capacity()) + " commands; send again";
-    }
-  }
-  if (!d.ok()) log_rejection(d, now);
-  return d;
+DecodedCommand CommandReceiver::submit(const void* data, std::size_t size) {
+  return intake_.submit(data, size, wall_utime_now());
 }
 
 void CommandReceiver::reply(const DecodedCommand& d, int64_t now_utime) {
@@ -115,7 +117,7 @@ void CommandReceiver::reply(const DecodedCommand& d, int64_t now_utime) {
   ack.reason = std::string(to_string(d.reason));
   ack.message = d.ok() ? "queued for the loop" : d.detail;
   try {
-    sign(ack, verifier_.key());
+    sign(ack, intake_.key());
     const auto bytes = lcm_encode(ack);
     if (lcm_->publish(ack_channel_, bytes.data(), static_cast<unsigned int>(bytes.size())) == 0) {
       acks_sent_.fetch_add(1, std::memory_order_relaxed);
@@ -125,32 +127,6 @@ void CommandReceiver::reply(const DecodedCommand& d, int64_t now_utime) {
   } catch (const std::exception& e) {
     spdlog::warn("operator commands: ack for sequence {} from '{}' not sent: {}", d.sequence, d.sender, e.what());
   }
-}
-
-void CommandReceiver::log_rejection(const DecodedCommand& d, int64_t now_utime) {
-  // Up to logs_per_second_ lines a second, then one line with the count of
-  // the rest: every rejection is counted, but a flood of forged packets must
-  // not fill the disk with log lines.
-  if (now_utime - log_window_start_ >= 1'000'000) {
-    if (suppressed_ > 0) {
-      const std::string text = fmt::format("{} more rejections not logged individually (see the counters)", suppressed_);
-      spdlog::warn("operator commands: {}", text);
-      if (on_rejection_logged_) on_rejection_logged_(RejectionNote{now_utime, "suppressed", 0, text});
-    }
-    log_window_start_ = now_utime;
-    logged_in_window_ = 0;
-    suppressed_ = 0;
-  }
-  if (logged_in_window_ >= logs_per_second_) {
-    ++suppressed_;
-    return;
-  }
-  ++logged_in_window_;
-  // The sender id is shown only once validated: it comes from the network.
-  const std::string text = fmt::format("operator command rejected ({}): {} [sender '{}', sequence {}]", to_string(d.reason),
-                                       d.detail, valid_sender_id(d.sender) ? d.sender : std::string("?"), d.sequence);
-  spdlog::warn("{}", text);
-  if (on_rejection_logged_) on_rejection_logged_(RejectionNote{now_utime, std::string(to_string(d.reason)), d.sequence, text});
 }
 
 }  // namespace rigctl

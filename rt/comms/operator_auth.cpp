@@ -124,6 +124,77 @@ DecodedCommand reject(DecodedCommand d, RejectReason r, std::string detail) {
   return d;
 }
 
+// Form, version, sender, sequence, tag and staleness of a decoded message:
+// what a command and a claim share. False (d's reason and detail set) when
+// it fails one of them.
+bool check_signed(const operator_command_t& msg, const OperatorKey& key, const CommandPolicy& policy, int64_t now_utime,
+                  DecodedCommand& d) {
+  d.sender = msg.sender;
+  d.sequence = msg.sequence;
+  d.utime = msg.utime;
+  // The version decides the canonical encoding, so it is checked before the tag.
+  if (msg.version != kOperatorWireVersion) {
+    d = reject(d, RejectReason::kBadVersion, "field 'version' = " + std::to_string(msg.version) + ", this rig speaks " + std::to_string(kOperatorWireVersion));
+    return false;
+  }
+  if (!valid_sender_id(msg.sender)) {
+    d = reject(d, RejectReason::kMalformed, "field 'sender' is not 1-64 chars of [A-Za-z0-9_.@-]");
+    return false;
+  }
+  if (msg.sequence <= 0) {
+    d = reject(d, RejectReason::kMalformed, "field 'sequence' = " + std::to_string(msg.sequence) + ", must be > 0");
+    return false;
+  }
+  // Nothing below is looked at before the tag verifies: an unauthenticated
+  // packet learns no more than "bad_tag".
+  const std::vector<uint8_t> canon = canonical_bytes(msg);
+  if (!tags_equal(hmac_sha256(key, canon.data(), canon.size()), msg.tag)) {
+    d = reject(d, RejectReason::kBadTag, "field 'tag' does not verify (forged, corrupted or signed with another key)");
+    return false;
+  }
+  // Difference in long double: utime - now can overflow int64 for hostile values.
+  const long double age_us = static_cast<long double>(now_utime) - static_cast<long double>(msg.utime);
+  if (age_us > policy.max_age_us || -age_us > policy.max_age_us) {
+    d = reject(d, RejectReason::kStale,
+               "field 'utime' is " + fmt_double(static_cast<double>(std::fabs(age_us)) * 1e-6) + " s " +
+                   (age_us > 0 ? "behind" : "ahead of") + " the rig's clock (window " +
+                   fmt_double(static_cast<double>(policy.max_age_us) * 1e-6) + " s)");
+    return false;
+  }
+  if (msg.utime < policy.not_before_utime) {
+    d = reject(d, RejectReason::kStale,
+               "field 'utime' is " + fmt_double(static_cast<double>(policy.not_before_utime - msg.utime) * 1e-6) +
+                   " s before this rig's command receiver started: a command from before a restart is not taken; send it again");
+    return false;
+  }
+  return true;
+}
+
+// The command and its value, once the message is authentic and fresh.
+DecodedCommand check_command(const operator_command_t& msg, const CommandPolicy& policy, DecodedCommand d) {
+  OperatorCommandKind kind{};
+  if (!parse_command_name(msg.command, kind)) return reject(d, RejectReason::kUnknownCommand, "field 'command' = '" + msg.command + "' is not a command");
+  if (!std::isfinite(msg.value)) return reject(d, RejectReason::kBadValue, "field 'value' = " + fmt_double(msg.value) + " is not finite");
+  if (kind == OperatorCommandKind::kSetpoint) {
+    if (!(policy.setpoint_min <= policy.setpoint_max)) {
+      return reject(d, RejectReason::kOutOfLimits, "setpoint " + fmt_double(msg.value) + ": no setpoint limits configured on this rig");
+    }
+    if (msg.value < policy.setpoint_min || msg.value > policy.setpoint_max) {
+      const std::string unit = policy.setpoint_unit.empty() ? "" : " " + policy.setpoint_unit;
+      return reject(d, RejectReason::kOutOfLimits,
+                    "setpoint " + fmt_double(msg.value) + unit + " outside [" + fmt_double(policy.setpoint_min) + ", " +
+                        fmt_double(policy.setpoint_max) + "]" + unit);
+    }
+  } else if (msg.value != 0.0) {
+    return reject(d, RejectReason::kBadValue, "field 'value' = " + fmt_double(msg.value) + " for '" + msg.command + "', which takes none (must be 0)");
+  }
+  d.reason = RejectReason::kNone;
+  d.command.kind = kind;
+  d.command.value = kind == OperatorCommandKind::kSetpoint ? msg.value : 0.0;
+  d.command.sequence = static_cast<uint64_t>(msg.sequence);
+  return d;
+}
+
 DecodedCommand decode_unchecked(const void* data, std::size_t size, const OperatorKey& key,
                                 const CommandPolicy& policy, int64_t now_utime) {
   DecodedCommand d;
@@ -146,52 +217,8 @@ DecodedCommand decode_unchecked(const void* data, std::size_t size, const Operat
   if (!r.f64(msg.value)) return reject(d, RejectReason::kMalformed, "truncated before field 'value'");
   if (!r.bytes(msg.tag, kOperatorTagBytes)) return reject(d, RejectReason::kMalformed, "truncated in field 'tag'");
   if (!r.at_end()) return reject(d, RejectReason::kMalformed, "trailing bytes after field 'tag'");
-
-  // The version decides the canonical encoding, so it is checked before the tag.
-  if (msg.version != kOperatorWireVersion) {
-    return reject(d, RejectReason::kBadVersion, "field 'version' = " + std::to_string(msg.version) + ", this rig speaks " + std::to_string(kOperatorWireVersion));
-  }
-  if (!valid_sender_id(msg.sender)) return reject(d, RejectReason::kMalformed, "field 'sender' is not 1-64 chars of [A-Za-z0-9_.@-]");
-  if (msg.sequence <= 0) return reject(d, RejectReason::kMalformed, "field 'sequence' = " + std::to_string(msg.sequence) + ", must be > 0");
-
-  // Nothing below is looked at before the tag verifies: an unauthenticated
-  // packet learns no more than "bad_tag".
-  const std::vector<uint8_t> canon = canonical_bytes(msg);
-  if (!tags_equal(hmac_sha256(key, canon.data(), canon.size()), msg.tag)) {
-    return reject(d, RejectReason::kBadTag, "field 'tag' does not verify (forged, corrupted or signed with another key)");
-  }
-
-  // Difference in long double: utime - now can overflow int64 for hostile values.
-  const long double age_us = static_cast<long double>(now_utime) - static_cast<long double>(msg.utime);
-  if (age_us > policy.max_age_us || -age_us > policy.max_age_us) {
-    return reject(d, RejectReason::kStale,
-                  "field 'utime' is " + fmt_double(static_cast<double>(std::fabs(age_us)) * 1e-6) + " s " +
-                      (age_us > 0 ? "behind" : "ahead of") + " the rig's clock (window " +
-                      fmt_double(static_cast<double>(policy.max_age_us) * 1e-6) + " s)");
-  }
-
-  OperatorCommandKind kind{};
-  if (!parse_command_name(msg.command, kind)) return reject(d, RejectReason::kUnknownCommand, "field 'command' = '" + msg.command + "' is not a command");
-  if (!std::isfinite(msg.value)) return reject(d, RejectReason::kBadValue, "field 'value' = " + fmt_double(msg.value) + " is not finite");
-  if (kind == OperatorCommandKind::kSetpoint) {
-    if (!(policy.setpoint_min <= policy.setpoint_max)) {
-      return reject(d, RejectReason::kOutOfLimits, "setpoint " + fmt_double(msg.value) + ": no setpoint limits configured on this rig");
-    }
-    if (msg.value < policy.setpoint_min || msg.value > policy.setpoint_max) {
-      const std::string unit = policy.setpoint_unit.empty() ? "" : " " + policy.setpoint_unit;
-      return reject(d, RejectReason::kOutOfLimits,
-                    "setpoint " + fmt_double(msg.value) + unit + " outside [" + fmt_double(policy.setpoint_min) + ", " +
-                        fmt_double(policy.setpoint_max) + "]" + unit);
-    }
-  } else if (msg.value != 0.0) {
-    return reject(d, RejectReason::kBadValue, "field 'value' = " + fmt_double(msg.value) + " for '" + msg.command + "', which takes none (must be 0)");
-  }
-
-  d.reason = RejectReason::kNone;
-  d.command.kind = kind;
-  d.command.value = kind == OperatorCommandKind::kSetpoint ? msg.value : 0.0;
-  d.command.sequence = static_cast<uint64_t>(msg.sequence);
-  return d;
+  if (!check_signed(msg, key, policy, now_utime, d)) return d;
+  return check_command(msg, policy, d);
 }
 
 bool decode_ack_unchecked(const void* data, std::size_t size, operator_ack_t& ack) {
@@ -235,6 +262,35 @@ OperatorKey::~OperatorKey() {
   if (!bytes_.empty()) OPENSSL_cleanse(bytes_.data(), bytes_.size());
 }
 
+namespace {
+
+// Another user who owns the key, or may write to its folder (and so replace
+// it with a key of their own), can command the rig: the mode alone does not
+// say who holds the secret.
+void check_key_owner(const std::string& path, const struct stat& st) {
+  const std::string what = "operator key file '" + path + "': ";
+  const uid_t me = ::geteuid();
+  if (st.st_uid != me && st.st_uid != 0) {
+    throw std::runtime_error(what + "is owned by uid " + std::to_string(st.st_uid) + ", not by this process's user (uid " +
+                             std::to_string(me) + ") or root: chown it to the service's user");
+  }
+  const std::size_t slash = path.rfind('/');
+  const std::string dir = slash == std::string::npos ? "." : slash == 0 ? "/" : path.substr(0, slash);
+  struct stat ds{};
+  if (::stat(dir.c_str(), &ds) != 0) throw std::runtime_error(what + "folder '" + dir + "': " + std::strerror(errno));
+  // A sticky folder (like /tmp) lets nobody but a file's owner remove or
+  // rename it, so its write bits give others no way to swap the key.
+  const bool others_write = (ds.st_mode & (S_IWGRP | S_IWOTH)) != 0 && (ds.st_mode & S_ISVTX) == 0;
+  if (others_write || (ds.st_uid != me && ds.st_uid != 0)) {
+    char mode[8];
+    std::snprintf(mode, sizeof mode, "%04o", static_cast<unsigned>(ds.st_mode & 07777));
+    throw std::runtime_error(what + "is in folder '" + dir + "' (mode " + mode + ", owner uid " + std::to_string(ds.st_uid) +
+                             ") where another user could replace it: keep the key in a folder only its owner (or root) may write to");
+  }
+}
+
+}  // namespace
+
 OperatorKey load_operator_key(const std::string& path) {
   const std::string what = "operator key file '" + path + "': ";
   // O_NOFOLLOW: the mode checked below must be the key's own, not a symlink's
@@ -258,6 +314,7 @@ OperatorKey load_operator_key(const std::string& path) {
     throw std::runtime_error(what + "is accessible by group or others (mode " + mode +
                              "); a key must be readable only by its owner: chmod 600 '" + path + "'");
   }
+  check_key_owner(path, st);
   if (st.st_size < static_cast<off_t>(kOperatorKeyMinBytes)) {
     throw std::runtime_error(what + "is " + std::to_string(st.st_size) + " bytes, a key needs at least " +
                              std::to_string(kOperatorKeyMinBytes) + " (head -c 32 /dev/urandom > key)");
@@ -299,6 +356,14 @@ OperatorTag hmac_sha256(const OperatorKey& key, const uint8_t* data, std::size_t
 }
 
 bool tags_equal(const OperatorTag& a, const uint8_t* b) { return CRYPTO_memcmp(a.data(), b, a.size()) == 0; }
+
+bool tag_from_hex(std::string_view hex, uint8_t* out) {
+  if (hex.size() != 2 * kOperatorTagBytes) return false;
+  const std::string text(hex);  // libcrypto wants a terminated string
+  std::size_t n = 0;
+  // Separator '\0': plain digit pairs only (no "ab:cd").
+  return OPENSSL_hexstr2buf_ex(out, kOperatorTagBytes, &n, text.c_str(), '\0') == 1 && n == kOperatorTagBytes;
+}
 
 std::vector<uint8_t> canonical_bytes(const operator_command_t& msg) {
   std::vector<uint8_t> out = start_with_label(kCommandLabel, 4 + 4 + msg.sender.size() + 8 + 8 + 4 + msg.command.size() + 8);
@@ -389,6 +454,8 @@ std::string_view to_string(RejectReason r) {
     case RejectReason::kOutOfLimits: return "out_of_limits";
     case RejectReason::kTooManySenders: return "too_many_senders";
     case RejectReason::kQueueFull: return "queue_full";
+    case RejectReason::kNotInControl: return "not_in_control";
+    case RejectReason::kControlHeld: return "control_held";
     case RejectReason::kCount: break;
   }
   return "unknown";
@@ -432,27 +499,45 @@ bool OperatorVerifier::make_room(int64_t now_utime) {
   return senders_.size() < max_senders_;
 }
 
+void OperatorVerifier::check_replay(DecodedCommand& d, int64_t now_utime) {
+  // Only authentic, fresh, valid messages reach the replay table: a forged
+  // packet cannot push a sender's sequence up and lock its real commands out.
+  auto it = senders_.find(d.sender);
+  if (it != senders_.end() && d.sequence <= it->second.last_sequence) {
+    d.reason = RejectReason::kReplayed;
+    d.detail = "field 'sequence' = " + std::to_string(d.sequence) + " is not above " +
+               std::to_string(it->second.last_sequence) + ", the last accepted from '" + d.sender + "'";
+  } else if (it == senders_.end() && !make_room(now_utime)) {
+    d.reason = RejectReason::kTooManySenders;
+    d.detail = "replay table full (" + std::to_string(max_senders_) + " senders active in the last " +
+               fmt_double(2e-6 * static_cast<double>(policy_.max_age_us)) + " s)";
+  } else {
+    SenderState& s = senders_[d.sender];
+    s.last_sequence = d.sequence;
+    s.last_accept_utime = now_utime;
+  }
+}
+
 DecodedCommand OperatorVerifier::verify(const void* data, std::size_t size, int64_t now_utime) {
   DecodedCommand d = decode_operator_command(data, size, key_, policy_, now_utime);
-  if (d.ok()) {
-    // Only authentic, fresh, valid commands reach the replay table: a forged
-    // packet cannot push a sender's sequence up and lock its real commands out.
-    auto it = senders_.find(d.sender);
-    if (it != senders_.end() && d.sequence <= it->second.last_sequence) {
-      d.reason = RejectReason::kReplayed;
-      d.detail = "field 'sequence' = " + std::to_string(d.sequence) + " is not above " +
-                 std::to_string(it->second.last_sequence) + ", the last accepted from '" + d.sender + "'";
-    } else if (it == senders_.end() && !make_room(now_utime)) {
-      d.reason = RejectReason::kTooManySenders;
-      d.detail = "replay table full (" + std::to_string(max_senders_) + " senders active in the last " +
-                 fmt_double(2e-6 * static_cast<double>(policy_.max_age_us)) + " s)";
-    } else {
-      SenderState& s = senders_[d.sender];
-      s.last_sequence = d.sequence;
-      s.last_accept_utime = now_utime;
-    }
-  }
+  if (d.ok()) check_replay(d, now_utime);
   counters_.add(d.reason);
+  return d;
+}
+
+DecodedCommand OperatorVerifier::verify_claim(const operator_command_t& msg, std::string_view name, int64_t now_utime) {
+  DecodedCommand d;
+  try {
+    if (msg.command != name || msg.value != 0.0) {
+      d = reject(d, RejectReason::kMalformed, "a claim is the command '" + std::string(name) + "' with value 0");
+    } else if (check_signed(msg, key_, policy_, now_utime, d)) {
+      d.reason = RejectReason::kNone;
+      check_replay(d, now_utime);
+    }
+  } catch (...) {  // libcrypto failing or no memory: a refusal, never an exception out of here
+    d = reject(d, RejectReason::kMalformed, "the claim could not be checked");
+  }
+  if (!d.ok()) counters_.add(d.reason);
   return d;
 }
 

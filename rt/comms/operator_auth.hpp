@@ -5,11 +5,14 @@
 //     file readable only by the service and the operators' `rigctl cmd`),
 //   * its sequence number is above the last one accepted from its sender
 //     (replay), and
-//   * its utime is within a window of the rig's clock (staleness). Sequence
-//     numbers alone are not enough: the table of last sequences lives in
-//     memory, so after a controller restart it is empty and every command
-//     ever captured would be accepted once more. The window limits that to
-//     commands captured in the last few seconds.
+//   * its utime is within a window of the rig's clock (staleness), and not
+//     before the receiver started. Sequence numbers alone are not enough:
+//     the table of last sequences lives in memory, so after a controller
+//     restart it is empty and every command ever captured would be accepted
+//     once more. The window limits that to commands captured in the last few
+//     seconds, and refusing what was signed before the start closes that gap
+//     too (simpler and safer than persisting the table: no file to lose,
+//     corrupt or roll back, and nothing written per command).
 // Wire format and canonical (MACed) encoding: docs/operator-commands.md and
 // canonical_bytes() below.
 #pragma once
@@ -61,7 +64,10 @@ class OperatorKey {
 
 // Reads a key file. Throws std::runtime_error naming the file and the problem:
 // missing/unreadable, not a regular file, readable or writable by group or
-// others (mode shown; "chmod 600" it), shorter than 32 bytes, larger than 4 KiB.
+// others (mode shown; "chmod 600" it), owned by another user than the
+// process's (or root), in a folder that another user may write to (group or
+// others writable without the sticky bit, or owned by another user), shorter
+// than 32 bytes, larger than 4 KiB.
 OperatorKey load_operator_key(const std::string& path);
 
 // HMAC-SHA256 (OpenSSL libcrypto).
@@ -69,6 +75,9 @@ OperatorTag hmac_sha256(const OperatorKey& key, const uint8_t* data, std::size_t
 // Constant-time comparison (CRYPTO_memcmp): the time taken does not tell an
 // attacker how many leading bytes of a guessed tag were right.
 bool tags_equal(const OperatorTag& a, const uint8_t* b);
+// A tag written as 64 hex digits (the console's JSON) into out[32], by
+// libcrypto's decoder; false for anything else (no separators, no prefix).
+bool tag_from_hex(std::string_view hex, uint8_t* out);
 
 // Canonical encodings, the bytes the tags are computed over (all integers
 // big-endian, strings as a uint32 byte count then the bytes, no terminator):
@@ -117,12 +126,15 @@ enum class RejectReason : uint8_t {
   kOutOfLimits,     // setpoint outside the configured limits (or none configured)
   kTooManySenders,  // replay table full of recently active senders
   kQueueFull,       // accepted but the loop's queue was full (CommandReceiver only)
+  kNotInControl,    // authentic, from a console that does not hold control (foxglove/console)
+  kControlHeld,     // an authentic claim of control while another console holds it
   kCount
 };
 inline constexpr std::size_t kRejectReasonCount = static_cast<std::size_t>(RejectReason::kCount);
 
 // "accepted", "malformed", "bad_version", "bad_tag", "stale", "replayed",
-// "unknown_command", "bad_value", "out_of_limits", "too_many_senders", "queue_full".
+// "unknown_command", "bad_value", "out_of_limits", "too_many_senders",
+// "queue_full", "not_in_control", "control_held".
 std::string_view to_string(RejectReason r);
 
 struct CommandPolicy {
@@ -134,6 +146,10 @@ struct CommandPolicy {
   double setpoint_min = std::numeric_limits<double>::quiet_NaN();
   double setpoint_max = std::numeric_limits<double>::quiet_NaN();
   std::string setpoint_unit;  // for messages only, e.g. "m"
+  // Commands dated before this [us since the epoch] are refused as stale:
+  // the receiver's start, so that nothing captured before a restart is
+  // taken after it (0: no such bound).
+  int64_t not_before_utime = 0;
 };
 
 struct DecodedCommand {
@@ -184,10 +200,20 @@ class OperatorVerifier {
   OperatorVerifier(OperatorKey key, CommandPolicy policy, std::size_t max_senders = 256);
 
   DecodedCommand verify(const void* data, std::size_t size, int64_t now_utime);
+  // A signed claim that is not an operator command (the console's
+  // take_control): the same checks of form, version, tag, staleness and
+  // replay, in the same replay table (one sequence per sender whatever it
+  // signs); its command must be `name` and its value 0. Refusals are counted
+  // as verify()'s; an accepted claim is not counted (it queues nothing).
+  DecodedCommand verify_claim(const operator_command_t& msg, std::string_view name, int64_t now_utime);
+  // A refusal decided after verification (the console's not_in_control or
+  // control_held, the receiver's queue_full): counted under `r` instead of
+  // accepted when `was_accepted`, else simply counted.
+  void count_refusal(RejectReason r, bool was_accepted) noexcept {
+    if (was_accepted) counters_.move(RejectReason::kNone, r);
+    else counters_.add(r);
+  }
 
-  // A command verify() accepted was refused after all (the receiver's
-  // queue_full): counted under `r` instead of accepted.
-  void reclassify_accepted(RejectReason r) noexcept { counters_.move(RejectReason::kNone, r); }
   const RejectCounters& counters() const { return counters_; }
   const OperatorKey& key() const { return key_; }
   const CommandPolicy& policy() const { return policy_; }
@@ -198,6 +224,8 @@ class OperatorVerifier {
     int64_t last_accept_utime = 0;  // rig clock
   };
   bool make_room(int64_t now_utime);
+  // The replay check and table update of an authentic, fresh message.
+  void check_replay(DecodedCommand& d, int64_t now_utime);
 
   OperatorKey key_;
   CommandPolicy policy_;

@@ -9,7 +9,7 @@
 // commands: traces update; take control; reset .. start drive the rig to
 //   running; a wrong key, a stale and a replayed hold are refused with their
 //   reasons and the rig stays as it was; a hold holds it; a second console
-//   can neither command nor take control; malformed messages from a raw
+//   may hold but neither resume nor take control; malformed messages from a raw
 //   client are answered and survived; a console that disconnects right
 //   after a command frees control; the first console stops the rig (S key).
 // trip: a run whose x_r is at its rail: the trips and the detector table.
@@ -135,8 +135,10 @@ async function secondConsole(browser, args, result, log) {
   await setField(b, "#sender", "bob");
   await setField(b, "#key", args.key);
   await b.click("h2");
-  await b.keyboard.press("h");  // the hold shortcut, from a console without control
+  await b.keyboard.press("h");  // the hold shortcut, from a console without control: stop and hold need none
   result.secondHold = await answer(b, "hold");
+  await b.click('#command-buttons button[data-command="resume"]');
+  result.secondResume = await answer(b, "resume");
   await b.click("#take-control");
   result.secondTakeControl = await answer(b, "take_control");
   result.stateAfterSecond = await state(b);

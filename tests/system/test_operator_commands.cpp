@@ -105,6 +105,30 @@ TEST(OperatorKeyFile, RefusesKeysOthersCouldReadOrThatAreTooShort) {
   EXPECT_NE(key_error(dir.path().string()).find("not a regular file"), std::string::npos);
 }
 
+TEST(OperatorKeyFile, RefusesKeysOfAnotherUserOrInAFolderOthersMayWrite) {
+  TempDir dir;
+  const fs::path open_dir = dir.path() / "open";
+  fs::create_directories(open_dir);
+  ::chmod(open_dir.c_str(), 0777);  // anyone could put a key of their own here
+  const std::string in_open = write_key(open_dir / "rig.key", 32, 0600);
+  const std::string e = key_error(in_open);
+  EXPECT_NE(e.find("another user could replace it"), std::string::npos) << e;
+  EXPECT_NE(e.find("0777"), std::string::npos) << e;
+  ::chmod(open_dir.c_str(), 01777);  // sticky, as /tmp: only a file's owner may remove or rename it
+  EXPECT_EQ(key_error(in_open), "");
+  ::chmod(open_dir.c_str(), 0770);
+  EXPECT_NE(key_error(in_open).find("another user could replace it"), std::string::npos);
+  ::chmod(open_dir.c_str(), 0700);
+  EXPECT_EQ(key_error(in_open), "");
+  if (::geteuid() != 0) GTEST_SKIP() << "changing a file's owner needs root";
+  const std::string theirs = write_key(dir.path() / "theirs.key", 32, 0600);
+  ASSERT_EQ(::chown(theirs.c_str(), 65534, 65534), 0);  // nobody's
+  const std::string t = key_error(theirs);
+  EXPECT_NE(t.find("owned by uid 65534"), std::string::npos) << t;
+  ASSERT_EQ(::chown(open_dir.c_str(), 65534, 65534), 0);  // a folder another user owns
+  EXPECT_NE(key_error(in_open).find("owner uid 65534"), std::string::npos) << key_error(in_open);
+}
+
 TEST(SequenceState, SurvivesBetweenInvocationsAndNeverGoesBack) {
   TempDir dir;
   const std::string path = (dir.path() / "sub" / "alice.seq").string();

@@ -84,10 +84,7 @@ std::unique_ptr<foxglove::TelemetryServer> make_foxglove_server(const RigConfig&
                                                                 const foxglove::StationDescription& station) {
   const auto ws = websocket_settings(config.telemetry.websocket, options.websocket);
   if (!ws) return nullptr;
-  foxglove::ServerOptions so;
-  so.address = ws->address;
-  so.port = static_cast<uint16_t>(ws->port);
-  so.client_queue_messages = static_cast<std::size_t>(ws->client_queue_messages);
+  foxglove::ServerOptions so = server_options(*ws);
   so.name = "rigctl " + std::string(to_string(config.rig));
   so.metadata = {{"rig", std::string(to_string(config.rig))},
                  {"driver", std::string(to_string(config.driver))},
@@ -279,12 +276,16 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
     spdlog::error("{}", text);
     publisher.report_event("log_write_failed", text);
   });
+  if (foxglove_server) foxglove_server->log_to(events);
   std::unique_ptr<CommandReceiver> receiver;
   SpscQueue<OperatorCommand>* commands = options.operator_commands;
   if (operator_run && commands == nullptr) {
     receiver = open_command_receiver(config, rig, url, op, events);
     commands = &receiver->queue();
-    if (foxglove_server) foxglove_server->enable_console_commands(*receiver);
+    if (foxglove_server) {
+      foxglove_server->enable_console_commands(receiver->intake(),
+                                               websocket_settings(config.telemetry.websocket, options.websocket)->control_timeout_s);
+    }
   }
   // The console's gateway hands commands to the receiver from the server's
   // thread: on any way out of this function the server stops before the

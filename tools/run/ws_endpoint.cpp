@@ -2,6 +2,7 @@
 
 #include <arpa/inet.h>
 
+#include <algorithm>
 #include <stdexcept>
 
 
@@ -54,6 +55,18 @@ std::optional<WebsocketConfig> websocket_settings(const std::optional<WebsocketC
   ws.port = option->port;
   if (option->address) ws.address = *option->address;
   return ws;
+}
+
+foxglove::ServerOptions server_options(const WebsocketConfig& ws) {
+  foxglove::ServerOptions so;
+  so.address = ws.address;
+  so.port = static_cast<uint16_t>(ws.port);
+  so.client_queue_messages = static_cast<std::size_t>(ws.client_queue_messages);
+  so.max_clients = static_cast<std::size_t>(ws.max_clients);
+  so.allowed_origins = ws.allowed_origins;
+  so.client_timeout_s = ws.client_timeout_s;
+  so.ping_interval_s = std::min(1.0, ws.control_timeout_s / 3.0);
+  return so;
 }
 
 }  // namespace rigctl

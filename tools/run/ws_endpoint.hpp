@@ -5,6 +5,7 @@
 #include <string>
 
 #include "config/rig_config.hpp"
+#include "foxglove/server/server.hpp"
 
 namespace rigctl {
 
@@ -21,5 +22,10 @@ WsEndpoint parse_ws_endpoint(const std::string& text);
 // it; nullopt when neither asks for a server.
 std::optional<WebsocketConfig> websocket_settings(const std::optional<WebsocketConfig>& config,
                                                   const std::optional<WsEndpoint>& option);
+
+// The server's options from the settings: address, port, queue, limits,
+// origins; pings often enough to tell a silent console within its
+// control timeout (a third of it, at most once a second).
+foxglove::ServerOptions server_options(const WebsocketConfig& ws);
 
 }  // namespace rigctl

@@ -8,7 +8,7 @@
 # -oom-, -leak-) and the command to reproduce it is printed.
 #   tools/scripts/fuzz.sh [SECONDS_PER_TARGET] [TARGET...]
 #     SECONDS_PER_TARGET  default 20; 0 only builds and replays the corpora
-#     TARGET              config run_file modbus canopen operator_command (default: all)
+#     TARGET              config run_file modbus canopen operator_command foxglove (default: all)
 #   FUZZ_JOBS=N  fuzzers run N at a time (default: the number of CPUs)
 # New inputs go to build-fuzz/work/<target>/ (kept between local runs, never
 # into the committed corpus). Installs clang and its fuzzer/sanitizer runtime
@@ -19,7 +19,8 @@ seconds=${1:-20}
 shift || true
 build="$root/build-fuzz"
 
-packages=(cmake make clang libclang-rt-14-dev libyaml-cpp-dev libeigen3-dev liblcm-dev liblcm-bin libglib2.0-dev libssl-dev)
+packages=(cmake make clang libclang-rt-14-dev libyaml-cpp-dev libeigen3-dev liblcm-dev liblcm-bin libglib2.0-dev libssl-dev
+          nlohmann-json3-dev)  # the Foxglove protocol's JSON (fuzz_foxglove)
 "$root/tools/scripts/install_packages.sh" fuzz "${packages[@]}"
 
 start=$(date +%s)
@@ -36,7 +37,7 @@ echo "fuzz: built in $(( $(date +%s) - start )) s"
 if [ $# -gt 0 ]; then
   targets=("$@")
 else
-  targets=(config run_file modbus canopen operator_command)
+  targets=(config run_file modbus canopen operator_command foxglove)
 fi
 for t in "${targets[@]}"; do
   [ -x "$build/fuzz_$t" ] || { echo "fuzz: no fuzzer $build/fuzz_$t" >&2; exit 1; }

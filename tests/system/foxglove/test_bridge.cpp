@@ -72,7 +72,7 @@ TEST_F(Bridge, ServesALogReplayedOnTheRigNetwork) {
   // browser would, with bash's /dev/tcp inside the namespace.
   const auto page = run_command(ns.exec_prefix() +
                                 "bash -c 'exec 3<>/dev/tcp/127.0.0.1/8765 && printf \"GET / HTTP/1.1\\r\\nHost: "
-                                "127.0.0.1\\r\\nConnection: close\\r\\n\\r\\n\" >&3 && cat <&3'");
+                                "127.0.0.1:8765\\r\\nConnection: close\\r\\n\\r\\n\" >&3 && cat <&3'");
   EXPECT_EQ(page.exit_code, 0) << page.output;
   EXPECT_EQ(page.output.rfind("HTTP/1.1 200", 0), 0U) << page.output.substr(0, 400);
   EXPECT_NE(page.output.find("Content-Security-Policy"), std::string::npos) << page.output.substr(0, 400);

@@ -124,8 +124,10 @@ TEST_F(Console, SignedCommandsFromTheBrowserDriveTheRigAndForgeriesChangeNothing
   EXPECT_EQ(r["stateAfterHold"], "holding");
   EXPECT_EQ(r["setpoint"]["reason"], "accepted") << r["setpoint"];
   EXPECT_EQ(r["setpointOutOfRange"]["reason"], "out_of_limits") << r["setpointOutOfRange"];
-  // The second console watches: it cannot command, nor take control.
-  EXPECT_EQ(r["secondHold"]["reason"], "not_in_control") << r["secondHold"];
+  // The second console watches: it may hold (stop and hold from every
+  // station), but neither resume nor take control.
+  EXPECT_EQ(r["secondHold"]["reason"], "accepted") << r["secondHold"];
+  EXPECT_EQ(r["secondResume"]["reason"], "not_in_control") << r["secondResume"];
   EXPECT_EQ(r["secondTakeControl"]["reason"], "control_held") << r["secondTakeControl"];
   EXPECT_EQ(r["stateAfterSecond"], "holding");
   // Malformed messages are answered, and the console goes on working.

@@ -198,6 +198,57 @@ TEST(OperatorVerifier, AfterARestartOnlyTheWindowStopsAReplay) {
   EXPECT_EQ(restarted.verify(captured.data(), captured.size(), kNow + 60'000'000).reason, RejectReason::kStale);
 }
 
+// Within the window too, once the verifier knows when it started: nothing
+// signed before the start is taken (the receiver sets it to its own start).
+TEST(OperatorVerifier, CommandsSignedBeforeTheStartAreRefused) {
+  const OperatorKey key = key_of(1);
+  CommandPolicy p = policy();
+  p.not_before_utime = kNow - 100'000;  // restarted 0.1 s ago
+  OperatorVerifier restarted(key, p);
+  const auto captured = signed_bytes(command("start", 77, 0.0, kNow - 700'000), key);  // signed 0.7 s ago
+  const DecodedCommand d = restarted.verify(captured.data(), captured.size(), kNow);
+  EXPECT_EQ(d.reason, RejectReason::kStale);
+  EXPECT_NE(d.detail.find("before this rig's command receiver started"), std::string::npos) << d.detail;
+  const auto fresh = signed_bytes(command("start", 78, 0.0, kNow - 50'000), key);
+  EXPECT_TRUE(restarted.verify(fresh.data(), fresh.size(), kNow).ok());
+}
+
+// A claim (the console's take_control) goes through the same checks and
+// the same replay table as commands; its refusals are counted.
+TEST(OperatorVerifier, AClaimIsCheckedLikeACommandInTheSameReplayTable) {
+  const OperatorKey key = key_of(1);
+  OperatorVerifier v(key, policy());
+  auto claim = [&](int64_t seq, const OperatorKey& k, int64_t utime = kNow, const char* name = "take_control") {
+    auto m = command(name, seq, 0.0, utime);
+    sign(m, k);
+    return v.verify_claim(m, "take_control", kNow);
+  };
+  EXPECT_EQ(claim(10, key_of(2)).reason, RejectReason::kBadTag);
+  EXPECT_EQ(claim(10, key, kNow - 3'000'000).reason, RejectReason::kStale);
+  EXPECT_EQ(claim(10, key, kNow, "hold").reason, RejectReason::kMalformed);  // a command is no claim
+  EXPECT_TRUE(claim(10, key).ok());
+  EXPECT_EQ(claim(10, key).reason, RejectReason::kReplayed);
+  const auto cmd = signed_bytes(command("hold", 10), key);  // the claim used sequence 10 of this sender
+  EXPECT_EQ(v.verify(cmd.data(), cmd.size(), kNow).reason, RejectReason::kReplayed);
+  EXPECT_EQ(v.counters().get(RejectReason::kReplayed), 2u);
+  EXPECT_EQ(v.counters().rejected(), 5u);
+  EXPECT_EQ(v.counters().accepted(), 0u);  // an accepted claim queues nothing
+}
+
+TEST(OperatorAuth, TagsAreReadFromHexByOneDecoder) {
+  uint8_t tag[kOperatorTagBytes];
+  const std::string hex64 = "5346b1f0a62ff91f2d21aba62f9e9eed9d13b6ba6a939b321319de2fc82773fd";
+  ASSERT_TRUE(tag_from_hex(hex64, tag));
+  EXPECT_EQ(tag[0], 0x53);
+  EXPECT_EQ(tag[31], 0xfd);
+  EXPECT_TRUE(tag_from_hex("5346B1F0A62FF91F2D21ABA62F9E9EED9D13B6BA6A939B321319DE2FC82773FD", tag));
+  EXPECT_FALSE(tag_from_hex(hex64.substr(2), tag));
+  EXPECT_FALSE(tag_from_hex(hex64 + "00", tag));
+  EXPECT_FALSE(tag_from_hex("zz" + hex64.substr(2), tag));
+  EXPECT_FALSE(tag_from_hex(std::string("53\0") + hex64.substr(3), tag));
+  EXPECT_FALSE(tag_from_hex("53:46" + hex64.substr(5), tag));
+}
+
 TEST(OperatorVerifier, MalformedMessagesAreRejectedAsMalformed) {
   const OperatorKey key = key_of(1);
   OperatorVerifier v(key, policy());

@@ -32,6 +32,30 @@ TEST(WebsocketSettings, ConfigGivesPortAndQueueAndBindsLoopbackUnlessToldOtherwi
   EXPECT_EQ(parse_rig_config(with_websocket(" {address: 0.0.0.0, port: 0}"), "q.yaml").telemetry.websocket->address, "0.0.0.0");
 }
 
+TEST(WebsocketSettings, LimitsOriginsAndTimeoutsReachTheServer) {
+  const auto defaults = parse_rig_config(with_websocket(" {port: 9000}"), "q.yaml").telemetry.websocket;
+  const auto d = server_options(*defaults);
+  EXPECT_EQ(d.max_clients, 16u);
+  EXPECT_TRUE(d.allowed_origins.empty());
+  EXPECT_EQ(d.client_timeout_s, 10.0);
+  EXPECT_EQ(d.ping_interval_s, 1.0);  // control_timeout_s 3: a ping a second
+  const auto ws = parse_rig_config(with_websocket(" {port: 9000, max_clients: 4, allowed_origins: [\"https://rig1.lab.example\"],"
+                                                  " control_timeout_s: 0.6, client_timeout_s: 5}"),
+                                   "q.yaml")
+                      .telemetry.websocket;
+  const auto o = server_options(*ws);
+  EXPECT_EQ(o.max_clients, 4u);
+  EXPECT_EQ(o.allowed_origins, std::vector<std::string>{"https://rig1.lab.example"});
+  EXPECT_EQ(o.client_timeout_s, 5.0);
+  EXPECT_DOUBLE_EQ(o.ping_interval_s, 0.2);  // a third of the control timeout
+  EXPECT_EQ(ws->control_timeout_s, 0.6);
+  test::expect_config_error(with_websocket(" {port: 1, allowed_origins: [\"rig1.lab.example\"]}"),
+                            {"telemetry.websocket.allowed_origins[0]", "is not an origin"});
+  test::expect_config_error(with_websocket(" {port: 1, allowed_origins: [\"https://rig1/path\"]}"), {"is not an origin"});
+  test::expect_config_error(with_websocket(" {port: 1, max_clients: 0}"), {"telemetry.websocket.max_clients"});
+  test::expect_config_error(with_websocket(" {port: 1, control_timeout_s: 0}"), {"telemetry.websocket.control_timeout_s"});
+}
+
 TEST(WebsocketSettings, BadValuesAreErrorsNamingTheKey) {
   test::expect_config_error(with_websocket(" {address: rigpc, port: 8765}"),
                             {"telemetry.websocket.address", "'rigpc' is not an IPv4 or IPv6 address"});
