@@ -267,8 +267,15 @@ class DamperModel : public RigModel {
   // effects: every cause enters as a missing force (docs/diagnosis.md 3),
   // and the regressors say which.
   std::vector<Place> places() const override {
-    return {{"a force of the damper (on f)", "N", 1.0, 0, false,
+    return {{"a force of the damper (on f)", "N", 1.0, -1, false,
              {"hysteresis", "command_lag", "coulomb_friction", "damper_asymmetry", "stiffness", "sensor_delay"}}};
+  }
+  // Not a sensor's error (whose library is its own channel's): the damper's
+  // force, free to follow the motion and the command.
+  void simulate_with_input(const std::vector<double>& th, std::size_t, const std::vector<double>& d,
+                           std::vector<std::vector<double>>& y) const override {
+    simulate(th, y);
+    for (std::size_t i = 0; i < y[0].size(); ++i) y[0][i] += d[i];
   }
   std::vector<Feature> features() const override {
     std::vector<double> uv(v_.size());
