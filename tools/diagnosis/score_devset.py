@@ -67,6 +67,8 @@ def diagnose(rigctl, case, truth, set_dir, json_dir, tmp, timeout):
         err = None if p.returncode == 0 else 'exit %d: %s' % (p.returncode, p.stderr.strip()[-300:])
     except subprocess.TimeoutExpired:
         err = 'timeout after %d s' % timeout
+    except OSError as e:  # the binary went away (a rebuild): this run fails, the others go on
+        err = 'cannot run %s: %s' % (rigctl, e)
     secs = time.monotonic() - t0
     if data.startswith(tmp):
         os.remove(data)
