@@ -125,7 +125,10 @@ def score(truths, json_dir):
                      'top': d['cause'] if d else 'error', 'unexplained': bool(d and d.get('unexplained')),
                      'where': where_text(d) if d else '', 'seconds': secs, 'missing': d is None})
 
-    def figures(sel):
+    def figures(every):
+        # A run with no diagnosis (failed, timed out, or not run yet) is
+        # counted apart, not as a miss: a partial scoring stays readable.
+        sel = [r for r in every if not r['missing']]
         single = [r for r in sel if r['kind'] == 'single']
         pairs = [r for r in sel if r['kind'] == 'pair']
         clean = [r for r in sel if r['kind'] == 'clean']
@@ -140,20 +143,22 @@ def score(truths, json_dir):
                 'unexplained': len(unexplained),
                 'unexplained_without_where': sum(1 for r in unexplained if not r['where']),
                 'median_s': statistics.median(secs) if secs else None, 'max_s': max(secs) if secs else None,
-                'over_60_s': sum(1 for s in secs if s > 60.0), 'runs': len(sel),
-                'not_diagnosed': sum(1 for r in sel if r['missing'])}
+                'over_60_s': sum(1 for s in secs if s > 60.0), 'runs': len(every),
+                'not_diagnosed': sum(1 for r in every if r['missing'])}
 
     rigs = sorted({r['rig'] for r in rows})
     result = {'all': figures(rows), 'per_rig': {rig: figures([r for r in rows if r['rig'] == rig]) for rig in rigs}}
     confusion = {}
     for r in rows:
-        if r['kind'] in ('single', 'clean'):
+        if r['kind'] in ('single', 'clean') and not r['missing']:
             got = r['top'] + (' (unexplained)' if r['unexplained'] else '')
             confusion.setdefault(r['truth'][0], {}).setdefault(got, 0)
             confusion[r['truth'][0]][got] += 1
     result['confusion'] = confusion
     misses = []
     for r in rows:
+        if r['missing']:
+            continue
         ok = {'single': r['top'] == r['truth'][0], 'clean': not r['named'],
               'pair': all(c in r['named'] for c in r['truth'])}[r['kind']]
         if ok:
@@ -162,10 +167,9 @@ def score(truths, json_dir):
         line = '%s %s: %s [%s] -> %s' % (r['case'], r['rig'], r['form'] or 'clean', r['strength'], got)
         if r['where']:
             line += '; ' + r['where']
-        if r['missing']:
-            line += ' (no diagnosis: it failed or was not run)'
         misses.append(line)
     result['misses'] = misses
+    result['not_diagnosed'] = [r['case'] for r in rows if r['missing']]
     result['runs'] = rows
     return result
 
@@ -176,11 +180,11 @@ def pct(a, b):
 
 def markdown(result, command):
     lines = ['# Diagnosis development set: score', '', 'Command: `%s`' % command, '',
-             '| rig | top-1 single | pair causes found | pairs with both | clean accused | unexplained (without where) '
-             '| median s | max s | > 60 s |', '|---|---|---|---|---|---|---:|---:|---:|']
+             '| rig | runs diagnosed | top-1 single | pair causes found | pairs with both | clean accused '
+             '| unexplained (without where) | median s | max s | > 60 s |', '|---|---|---|---|---|---|---|---:|---:|---:|']
     for name, f in [('all', result['all'])] + sorted(result['per_rig'].items()):
-        lines.append('| %s | %s | %s | %s | %s | %d (%d) | %s | %s | %d |' % (
-            name, pct(f['top1'], f['single']), pct(f['pair_causes_found'], f['pair_causes']),
+        lines.append('| %s | %d/%d | %s | %s | %s | %s | %d (%d) | %s | %s | %d |' % (
+            name, f['runs'] - f['not_diagnosed'], f['runs'], pct(f['top1'], f['single']), pct(f['pair_causes_found'], f['pair_causes']),
             pct(f['pairs_both'], f['pairs']), pct(f['clean_accused'], f['clean']), f['unexplained'],
             f['unexplained_without_where'], '%.1f' % f['median_s'] if f['median_s'] is not None else '-',
             '%.1f' % f['max_s'] if f['max_s'] is not None else '-', f['over_60_s']))
@@ -190,6 +194,8 @@ def markdown(result, command):
         lines.append('| %s | %s |' % (true, ', '.join('%s x%d' % (g, n) for g, n in sorted(got.items()))))
     lines += ['', '## Misses', '']
     lines += ['* ' + m for m in result['misses']] or ['none']
+    if result['not_diagnosed']:
+        lines += ['', 'Not diagnosed (failed, timed out or not run): ' + ', '.join(result['not_diagnosed'])]
     return '\n'.join(lines) + '\n'
 
 
