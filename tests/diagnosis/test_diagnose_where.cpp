@@ -128,6 +128,13 @@ TEST(DiagnoseWhere, ReportShowsWhereOnTheEmpsRecord) {
   expect_report_shows_where(d, "a force on the axis");
   EXPECT_TRUE(d.where.significant) << listing(d.where);
   EXPECT_TRUE(has_regressor(d.where.places.front(), "sign(v)", 2)) << listing(d.where);
+  // With no candidate tried the misfit is unexplained, and says where it is.
+  ASSERT_TRUE(d.unexplained);
+  std::ostringstream json;
+  diag::write_json(d, json);
+  const auto u = json.str().find("\"unexplained_residual\"");
+  ASSERT_NE(u, std::string::npos);
+  EXPECT_NE(json.str().find("\"where\": \"a force on the axis that follows", u), std::string::npos) << json.str();
 }
 
 TEST(DiagnoseWhere, ReportShowsWhereOnTheMrDamperRecord) {
