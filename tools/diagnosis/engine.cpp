@@ -15,6 +15,7 @@
 #include "tools/diagnosis/criteria.hpp"
 #include "tools/diagnosis/evidence.hpp"
 #include "tools/diagnosis/parallel.hpp"
+#include "tools/diagnosis/where.hpp"
 #include "tools/diagnosis/workspace.hpp"
 
 namespace rigctl::diag {
@@ -249,9 +250,11 @@ Candidate refit_one(const Workspace& w, const Candidate& screened, const Scored&
 // independent), each judged against the current model; the screening
 // record in screening order.
 std::vector<Candidate> refit_best(const Workspace& w, std::vector<Candidate> screened, const Scored& current,
-                                  const std::vector<std::size_t>& active, int round, Diagnosis& d) {
+                                  const std::vector<std::size_t>& active, int round, Diagnosis& d,
+                                  std::size_t extra = 0) {
   const double neff = w.n_eff(current);  // every candidate of the round is compared at this one
-  const std::size_t top = std::min(screened.size(), static_cast<std::size_t>(std::max(0, w.options.refit_top)));
+  const std::size_t top =
+      std::min(screened.size(), static_cast<std::size_t>(std::max(0, w.options.refit_top)) + extra);
   std::vector<Candidate> refits(top);
   parallel_for(top, [&](std::size_t c, std::size_t) { refits[c] = refit_one(w, screened[c], current, active, neff, round); });
   for (std::size_t c = 0; c < screened.size(); ++c) {
@@ -275,6 +278,20 @@ std::vector<Candidate> refit_best(const Workspace& w, std::vector<Candidate> scr
     d.screened.push_back(sc);
   }
   return refits;
+}
+
+// Where before what: the best-screened candidate entering where the misfit
+// is is refitted too when none of the best few does (where.hpp).
+std::size_t promote_where(const Workspace& w, const WhereResult& where, std::vector<Candidate>& screened) {
+  std::vector<std::string> causes;
+  for (const auto& c : screened) causes.push_back(w.effects[c.effect].cause);
+  const auto top = static_cast<std::size_t>(std::max(0, w.options.refit_top));
+  const std::size_t k = where_promotion(where, causes, top);
+  if (k >= screened.size()) return 0;
+  w.say("where: refitting " + causes[k] + " too (it enters where the misfit is)");
+  std::rotate(screened.begin() + static_cast<std::ptrdiff_t>(top), screened.begin() + static_cast<std::ptrdiff_t>(k),
+              screened.begin() + static_cast<std::ptrdiff_t>(k + 1));
+  return 1;
 }
 
 // The largest passing gain wins; one with fewer parameters wins a near tie.
@@ -355,6 +372,9 @@ CauseResult describe(const Workspace& w, const Candidate& win, const std::vector
          << fmt(100.0 * (c.value - c.nominal) / c.nominal, 3) << " %, " << fmt(kCauseBandTolerances, 2)
          << " tolerances): the run asked for more, which is this cause";
   if (!cr.signature.empty()) ev << "; signature: " << cr.signature;
+  cr.where_agrees = where_agrees(d.where, cr.cause);
+  if (!cr.where_agrees)
+    ev << "; its place disagrees with where the baseline's misfit is (" << d.where.sentence << ")";
   if (!cr.ambiguous_with.empty()) {
     ev << "; about as well explained by";
     for (const auto& a : cr.ambiguous_with) ev << " " << a;
@@ -478,6 +498,8 @@ Diagnosis diagnose(const RigModel& model, const DiagnoseOptions& opt) {
 
   w.say("baseline calibration (" + std::to_string(w.n_base) + " parameters, " + std::to_string(w.n) + " samples)");
   const Scored base = calibrate_baseline(w, d);
+  d.where = locate(w, base);
+  if (d.where.computed) w.say("where: " + d.where.sentence);
   {
     std::string s = "baseline held-out fit:";
     for (std::size_t o = 0; o < w.outs().size(); ++o) s += " " + w.outs()[o].name + " " + fmt(base.fit[o]) + " %";
@@ -488,7 +510,8 @@ Diagnosis diagnose(const RigModel& model, const DiagnoseOptions& opt) {
   for (int round = 1; round <= (opt.calibration_only ? 0 : opt.max_effects); ++round) {
     auto screened = screen(w, current, active, round);
     if (screened.empty()) break;
-    const auto refits = refit_best(w, std::move(screened), current, active, round, d);
+    const std::size_t promoted = round == 1 ? promote_where(w, d.where, screened) : 0;
+    const auto refits = refit_best(w, std::move(screened), current, active, round, d, promoted);
     const Candidate* win = choose(w, refits);
     if (!win) break;
     for (auto& sc : d.screened)

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "tools/diagnosis/model.hpp"
+#include "tools/diagnosis/where_result.hpp"
 
 namespace rigctl::diag {
 
@@ -50,6 +51,9 @@ struct CauseResult {
   std::string signal;
   std::vector<std::string> ambiguous_with;  // candidates that explained the residual about as well
   std::string signature;                    // what the residual shows of the effect's signature
+  // Whether the cause enters where the baseline's misfit is (where.hpp
+  // where_agrees); false flags a cause named at another place.
+  bool where_agrees = true;
 };
 
 struct ScreenedCandidate {
@@ -84,6 +88,8 @@ struct Diagnosis {
     double band_lo_hz = 0.0, band_hi_hz = 0.0, peak_hz = 0.0;  // 10-90 % of its power, and its peak
   };
   Residual unexplained_residual;
+  // Where the calibrated baseline misses a signal (docs/diagnosis.md 3).
+  WhereResult where;
   std::vector<std::string> stubs;  // cause ids whose candidate is not implemented yet
   double elapsed_s = 0.0;
 

@@ -108,6 +108,43 @@ class RigModel {
     std::vector<double> values;
   };
   virtual Indicator indicator(const std::string& cause) const = 0;
+  // Where an effect can enter the model (docs/diagnosis.md 3, "Where"):
+  // a force on a body, a flow into a chamber, an error on a sensor. The
+  // engine reconstructs, at each place, the missing signal the calibrated
+  // baseline lacks (tools/diagnosis/where.*). `output` >= 0 with `in_loop`
+  // false: an error added to that output after the replay (the engine does
+  // it); otherwise the model adds the signal in simulate_with_input.
+  // `causes`: the cause ids whose effect enters here (the place map).
+  struct Place {
+    std::string name, unit;
+    double scale = 1.0;  // a typical size of the signal there (the linearisation's step)
+    int output = -1;
+    bool in_loop = false;
+    std::vector<std::string> causes;
+  };
+  virtual std::vector<Place> places() const { return {}; }
+  // The replay with the signal d (one value per sample, held over the
+  // period) added at place `place`. Only for places the model adds itself.
+  virtual void simulate_with_input(const std::vector<double>& theta, std::size_t /*place*/,
+                                   const std::vector<double>& /*d*/, std::vector<std::vector<double>>& y) const {
+    simulate(theta, y);
+  }
+  // Measured signals a missing signal may be a function of (the feature
+  // library of the "where"), each with how it enters the library.
+  // A velocity enters by its sign and value, a command by its value and its
+  // part near null, a position by its value and the travel since its last
+  // reversal (raw and saturating: hysteresis), a value as it is.
+  enum class FeatureKind { kVelocity, kValue, kCommand, kPosition };
+  struct Feature {
+    std::string name;
+    FeatureKind kind = FeatureKind::kValue;
+    std::vector<double> values;
+    // The outputs it is measured from: at a sensor's place the engine leaves
+    // out the features of that sensor's own measurement (error = measured -
+    // replay would fit its residual exactly, anywhere).
+    std::vector<int> from;
+  };
+  virtual std::vector<Feature> features() const { return {}; }
   // The force (or other) term an effect adds, at parameters theta, along the
   // record; for the report's "effect curve vs indicator" plot. May be empty.
   virtual std::vector<double> effect_term(const std::string& /*cause*/, const std::vector<double>& /*theta*/) const {

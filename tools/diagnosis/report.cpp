@@ -62,6 +62,27 @@ std::string json_list(const std::vector<std::string>& v) {
   return s + "]";
 }
 
+// The "where" (docs/diagnosis.md 3): the best place with its regressors,
+// then every place's shares.
+std::string json_where(const WhereResult& w) {
+  const auto& b = w.places.front();
+  std::string s = "{\"place\": " + json_string(b.name) + ", \"unit\": " + json_string(b.unit) +
+                  ", \"significant\": " + (w.significant ? "true" : "false") +
+                  ", \"explained_share\": " + json_number(b.explained_share) +
+                  ", \"share_above_noise\": " + json_number(b.share_above_noise) + ", \"causes\": " + json_list(b.causes) +
+                  ",\n    \"regressors\": [";
+  for (std::size_t j = 0; j < b.regressors.size(); ++j)
+    s += std::string(j ? ", " : "") + "{\"feature\": " + json_string(b.regressors[j].feature) +
+         ", \"coefficient\": " + json_number(b.regressors[j].coefficient) +
+         ", \"share\": " + json_number(b.regressors[j].share) + "}";
+  s += "],\n    \"sentence\": " + json_string(w.sentence) + ",\n    \"places\": [";
+  for (std::size_t j = 0; j < w.places.size(); ++j)
+    s += std::string(j ? ",\n      " : "\n      ") + "{\"place\": " + json_string(w.places[j].name) +
+         ", \"explained_share\": " + json_number(w.places[j].explained_share) +
+         ", \"share_above_noise\": " + json_number(w.places[j].share_above_noise) + "}";
+  return s + "]}";
+}
+
 }  // namespace
 
 void write_json(const Diagnosis& d, std::ostream& out) {
@@ -86,7 +107,7 @@ void write_json(const Diagnosis& d, std::ostream& out) {
         << ", \"extended_fit_percent\": " << json_number(c.extended_fit_percent)
         << ", \"gain_percent_points\": " << json_number(c.gain_percent_points) << ", \"signal\": " << json_string(c.signal)
         << ",\n     \"ambiguous_with\": " << json_list(c.ambiguous_with) << ", \"signature\": " << json_string(c.signature)
-        << "}";
+        << ", \"where_agrees\": " << (c.where_agrees ? "true" : "false") << "}";
   }
   out << (d.causes.empty() ? "],\n" : "\n  ],\n");
   out << "  \"baseline_fit_percent\": " << json_number_map(d.baseline_fit_percent) << ",\n";
@@ -97,8 +118,10 @@ void write_json(const Diagnosis& d, std::ostream& out) {
     const auto& u = d.unexplained_residual;
     out << "  \"unexplained_residual\": {\"signal\": " << json_string(u.signal) << ", \"rms\": " << json_number(u.rms)
         << ", \"noise_floor\": " << json_number(u.noise) << ", \"band_hz\": [" << json_number(u.band_lo_hz) << ", "
-        << json_number(u.band_hi_hz) << "], \"peak_hz\": " << json_number(u.peak_hz) << "},\n";
+        << json_number(u.band_hi_hz) << "], \"peak_hz\": " << json_number(u.peak_hz)
+        << ", \"where\": " << json_string(d.where.sentence) << "},\n";
   }
+  if (d.where.computed) out << "  \"where\": " << json_where(d.where) << ",\n";
   out << "  \"baseline_calibration\": [";
   for (std::size_t j = 0; j < d.calibration.size(); ++j) {
     const auto& c = d.calibration[j];
@@ -216,6 +239,33 @@ std::string svg_plot(const std::string& title, const std::string& xl, const std:
   return o.str();
 }
 
+// Where the baseline's misfit is: the places ranked, and the reconstructed
+// missing signal at the best one against time and its strongest regressor.
+void write_where_html(const Diagnosis& d, std::ostream& out) {
+  const auto& w = d.where;
+  if (!w.computed) return;
+  out << "<h2 id='where'>Where the misfit is</h2>\n<p>Before any candidate: the calibrated baseline misses "
+      << esc(w.sentence) << ".</p>\n";
+  out << "<table><tr><th>place</th><th>held-out residual explained</th><th>of its part above the noise</th>"
+         "<th>regressors (coefficient, share)</th><th>causes entering here</th></tr>\n";
+  for (const auto& p : w.places) {
+    out << "<tr><td>" << esc(p.name) << " [" << esc(p.unit) << "]</td><td>" << fmt(100.0 * p.explained_share, 3)
+        << " %</td><td>" << fmt(100.0 * p.share_above_noise, 3) << " %</td><td>";
+    for (const auto& r : p.regressors)
+      out << esc(r.feature) << " (" << fmt(r.coefficient, 3) << ", " << fmt(100.0 * r.share, 2) << " %)<br>";
+    out << "</td><td>";
+    for (const auto& c : p.causes) out << "<code>" << esc(c) << "</code> ";
+    out << "</td></tr>\n";
+  }
+  out << "</table>\n";
+  if (w.signal.empty() || w.places.empty()) return;
+  const std::string label = "missing signal at " + w.places.front().name + " [" + w.places.front().unit + "]";
+  out << svg_plot("Where: " + label, "t [s]", w.places.front().unit, {{label, "#9467bd", &d.t, &w.signal}});
+  if (!w.feature_values.empty())
+    out << svg_plot("Where: the missing signal against " + w.feature_name, w.feature_name, w.places.front().unit,
+                    {{label, "#9467bd", &w.feature_values, &w.signal, true}});
+}
+
 }  // namespace
 
 void write_report(const Diagnosis& d, std::ostream& out) {
@@ -237,6 +287,7 @@ void write_report(const Diagnosis& d, std::ostream& out) {
   }
   out << "</table>\n";
   for (const auto& c : d.causes) out << "<p><b>" << esc(c.cause) << "</b>: " << esc(c.evidence) << "</p>\n";
+  write_where_html(d, out);
   out << "<h2>Fit per signal (held-out)</h2><table><tr><th>signal</th><th>baseline %</th><th>final %</th></tr>";
   for (const auto& [k, v] : d.baseline_fit_percent)
     out << "<tr><td>" << esc(k) << "</td><td>" << v << "</td><td>" << d.extended_fit_percent.at(k) << "</td></tr>";

@@ -76,6 +76,33 @@ class LinearAxisModel : public RigModel {
            "with an implicit (stick-capable) friction update";
   }
   void simulate(const std::vector<double>& th, std::vector<std::vector<double>>& y) const override {
+    run(th, y, 0, nullptr);
+  }
+  // Where an effect can enter (docs/diagnosis.md 3): run()'s `place`.
+  std::vector<Place> places() const override {
+    return {{"a force on the axis", "N", 0.1, -1, false,
+             {"coulomb_friction", "asymmetric_friction", "stribeck_friction", "force_offset", "compliance"}},
+            {"an error on the x sensor (the feedback)", "m", 1e-6, 1, true, {"sensor_delay"}}};
+  }
+  std::vector<Feature> features() const override {
+    return {{"v", FeatureKind::kVelocity, vel_, {1}},
+            {"acceleration", FeatureKind::kValue, central_diff(vel_, dt_), {1}},
+            {"x", FeatureKind::kPosition, outputs_[1].measured, {1}}};
+  }
+  void simulate_with_input(const std::vector<double>& th, std::size_t place, const std::vector<double>& d,
+                           std::vector<std::vector<double>>& y) const override {
+    run(th, y, place, &d);
+  }
+  Indicator indicator(const std::string& cause) const override {
+    if (cause == "compliance") return {"acceleration [m/s^2]", central_diff(vel_, dt_)};
+    return {"velocity [m/s] (from measured x)", vel_};
+  }
+
+ private:
+  // added: the where's signal at places()[place] per sample (null: none).
+  void run(const std::vector<double>& th, std::vector<std::vector<double>>& y, std::size_t place,
+           const std::vector<double>* added) const {
+    auto extra = [&](std::size_t p, std::size_t i) { return added && place == p ? (*added)[i] : 0.0; };
     const double M = th[0], Fv = th[1], Fc = th[2], dFc = th[3], dFv = th[4], Fs = th[5], vs = th[6], off = th[7],
                  comp = th[8] * 1e-6, tau = th[9];
     const std::size_t n = t_.size();
@@ -94,7 +121,8 @@ class LinearAxisModel : public RigModel {
     double xm_prev = x, xf_prev = x;
     for (std::size_t i = 0; i < n; ++i) {
       hist[i] = x;
-      const double xs = tau > 0.0 ? at(hist, std::min(static_cast<double>(i), static_cast<double>(i) - tau / dt_)) : x;
+      const double xs = (tau > 0.0 ? at(hist, std::min(static_cast<double>(i), static_cast<double>(i) - tau / dt_)) : x) +
+                        extra(1, i);
       const double xf = 0.5 * (xs + xm_prev);
       const double xd = i == 0 ? 0.0 : (xf - xf_prev) / dt_;
       xm_prev = xs;
@@ -104,7 +132,7 @@ class LinearAxisModel : public RigModel {
       y[0][i] = F;
       y[1][i] = xs;
       for (int s = 0; s < sub; ++s) {
-        double f = F + f_ext_[i] - off;
+        double f = F + f_ext_[i] - off + extra(0, i);
         if (flex) f -= k * (x - x2) + c * (v - v2);
         const double g = Fs > 0.0 ? Fs * std::exp(-(v / vs) * (v / vs)) : 0.0;
         v = implicit_velocity(m1, v, f, h, cp + g, cn + g, dp, dn);
@@ -120,10 +148,8 @@ class LinearAxisModel : public RigModel {
       }
     }
   }
-  Indicator indicator(const std::string& cause) const override {
-    if (cause == "compliance") return {"acceleration [m/s^2]", central_diff(vel_, dt_)};
-    return {"velocity [m/s] (from measured x)", vel_};
-  }
+
+ public:
   std::vector<double> effect_term(const std::string&, const std::vector<double>& th) const override {
     // The fitted friction force at the measured velocity (what the residual of u should follow).
     std::vector<double> f(vel_.size());
@@ -236,6 +262,29 @@ class DamperModel : public RigModel {
       ue = lag > 0.0 ? un + (ue - un) * lag : un;
     }
     delay(y[0], tau_f, dt_);
+  }
+  // The force is the only output and the model is memoryless but for its
+  // effects: every cause enters as a missing force (docs/diagnosis.md 3),
+  // and the regressors say which.
+  std::vector<Place> places() const override {
+    return {{"a force of the damper (on f)", "N", 1.0, -1, false,
+             {"hysteresis", "command_lag", "coulomb_friction", "damper_asymmetry", "stiffness", "sensor_delay"}}};
+  }
+  // Not a sensor's error (whose library is its own channel's): the damper's
+  // force, free to follow the motion and the command.
+  void simulate_with_input(const std::vector<double>& th, std::size_t, const std::vector<double>& d,
+                           std::vector<std::vector<double>>& y) const override {
+    simulate(th, y);
+    for (std::size_t i = 0; i < y[0].size(); ++i) y[0][i] += d[i];
+  }
+  std::vector<Feature> features() const override {
+    std::vector<double> uv(v_.size());
+    for (std::size_t i = 0; i < uv.size(); ++i) uv[i] = u_[i] * v_[i];
+    return {{"v", FeatureKind::kVelocity, v_, {}},
+            {"u", FeatureKind::kValue, u_, {}},
+            {"u v", FeatureKind::kValue, uv, {}},
+            {"x", FeatureKind::kPosition, x_, {}},
+            {"du/dt", FeatureKind::kValue, central_diff(u_, dt_), {}}};
   }
   Indicator indicator(const std::string& cause) const override {
     if (cause == "command_lag") return {"du/dt [V/s]", central_diff(u_, dt_)};

@@ -158,6 +158,73 @@ class HalfCarDiagModel : public RigModel {
   }
 
   void simulate(const std::vector<double>& th, std::vector<std::vector<double>>& y) const override {
+    run(th, y, kNoPlace, nullptr);
+  }
+  // Where an effect can enter (docs/diagnosis.md 3); the order is run()'s
+  // `place`. The sensors' errors the engine adds after the replay.
+  std::vector<Place> places() const override {
+    return {{"a heave force on the body", "N", 1.0, -1, false, {}},
+            {"a pitch moment on the body", "N m", 1.0, -1, false, {}},
+            {"a force between body and wheel 1 (suspension and actuator 1)", "N", 1.0, -1, false,
+             {"actuator_lag", "damper_asymmetry"}},
+            {"a force between body and wheel 2 (suspension and actuator 2)", "N", 1.0, -1, false,
+             {"actuator_lag", "damper_asymmetry"}},
+            {"a force on wheel 1 (its tyre)", "N", 1.0, -1, false, {"tyre_liftoff"}},
+            {"a force on wheel 2 (its tyre)", "N", 1.0, -1, false, {"tyre_liftoff"}},
+            {"an error on the z_s sensor", "m", 1e-5, 0, false, {"sensor_delay"}},
+            {"an error on the phi sensor", "rad", 1e-5, 1, false, {"sensor_delay"}},
+            {"an error on the z_u1 sensor", "m", 1e-5, 2, false, {"sensor_delay"}},
+            {"an error on the z_u2 sensor", "m", 1e-5, 3, false, {"sensor_delay"}}};
+  }
+  std::vector<Feature> features() const override {
+    std::vector<Feature> f;
+    const double kt[2] = {p_.tyre_stiffness_1, p_.tyre_stiffness_2};
+    for (std::size_t w = 0; w < 2; ++w) {
+      const std::string c = std::to_string(w + 1);
+      std::vector<double> rate(t_.size()), load(t_.size());
+      for (std::size_t i = 0; i < t_.size(); ++i) {
+        rate[i] = outputs_[0].measured[i] + lever_[w] * outputs_[1].measured[i] - outputs_[2 + w].measured[i];
+        load[i] = static_load_[w] + kt[w] * (zr_[w][i] - outputs_[2 + w].measured[i]);
+      }
+      const int wheel = static_cast<int>(2 + w);  // outputs: z_s 0, phi 1, z_u1 2, z_u2 3
+      f.push_back({"suspension rate " + c, FeatureKind::kVelocity, central_diff(rate, dt_), {0, 1, wheel}});
+      f.push_back({"v_u" + c, FeatureKind::kVelocity, central_diff(outputs_[2 + w].measured, dt_), {wheel}});
+      f.push_back({"tyre load " + c, FeatureKind::kValue, load, {wheel}});
+      if (active_) {
+        f.push_back({"f_" + c, FeatureKind::kValue, f_[w]});
+        f.push_back({"df_" + c + "/dt", FeatureKind::kValue, central_diff(f_[w], dt_)});
+      }
+    }
+    return f;
+  }
+  void simulate_with_input(const std::vector<double>& th, std::size_t place, const std::vector<double>& d,
+                           std::vector<std::vector<double>>& y) const override {
+    run(th, y, place, &d);
+  }
+
+  Indicator indicator(const std::string& cause) const override {
+    if (cause == "actuator_lag") return {"df_1/dt, commanded [N/s]", df1_};
+    if (cause == "tyre_liftoff") return {"lower tyre load / static load (from measured z_r - z_u)", load_};
+    if (cause == "damper_asymmetry") return {"corner-1 suspension rate [m/s] (from measured)", rate1_};
+    if (cause == "sensor_delay") return {"dz_u1/dt [m/s]", vu1_};
+    return {};
+  }
+
+ private:
+  static constexpr std::size_t kNoPlace = static_cast<std::size_t>(-1);
+  // The replay; d: the where's signal at places()[place] (null: none).
+  void run(const std::vector<double>& th, std::vector<std::vector<double>>& y, std::size_t place,
+           const std::vector<double>* added) const {
+    // What the where adds over sample i: heave, pitch, corner and wheel forces.
+    double e_heave = 0.0, e_pitch = 0.0, e_corner[2] = {0.0, 0.0}, e_wheel[2] = {0.0, 0.0};
+    auto set_added = [&](std::size_t i) {
+      if (!added) return;
+      const double v = (*added)[i];
+      e_heave = place == 0 ? v : 0.0;
+      e_pitch = place == 1 ? v : 0.0;
+      e_corner[0] = place == 2 ? v : 0.0, e_corner[1] = place == 3 ? v : 0.0;
+      e_wheel[0] = place == 4 ? v : 0.0, e_wheel[1] = place == 5 ? v : 0.0;
+    };
     const double c[2] = {th[0], th[1]};
     const double k[2] = {th[2], th[3]};
     const double kt[2] = {th[4], th[5]};
@@ -186,23 +253,24 @@ class HalfCarDiagModel : public RigModel {
         const double travel = s[0] + l * s[1] - s[2 + w];
         const double rate = s[4] + l * s[5] - s[6 + w];
         const double damp = c[w] * (1.0 + (asym != 0.0 ? asym * std::tanh(rate / kRateBand) : 0.0)) * rate;
-        const double fb = -k[w] * travel - damp + fact[w];
+        const double fb = -k[w] * travel - damp + fact[w] + e_corner[w];
         heave += fb;
         moment += l * fb;
         const double ft = static_load[w] + kt[w] * (zr[w] - s[2 + w]) + ct[w] * (vr[w] - s[6 + w]);
         const double fe = uni > 0.0 ? (1.0 - uni) * ft + uni * softplus(ft, eps[w]) : ft;
         d[2 + w] = s[6 + w];
-        d[6 + w] = (fe - static_load[w] - fb) / mu[w];
+        d[6 + w] = (fe - static_load[w] - fb + e_wheel[w]) / mu[w];
       }
       d[0] = s[4];
       d[1] = s[5];
-      d[4] = heave / ms;
-      d[5] = moment / inertia;
+      d[4] = (heave + e_heave) / ms;
+      d[5] = (moment + e_pitch) / inertia;
     };
     std::array<double, 8> k1, k2, k3, k4, s;
     for (std::size_t i = 0; i < n; ++i) {
       for (std::size_t c4 = 0; c4 < 4; ++c4) y[c4][i] = q[c4];
       if (i + 1 == n) break;
+      set_added(i);
       double vr[2], zr0[2];
       for (std::size_t w = 0; w < 2; ++w) {
         zr0[w] = zr_[w][i];
@@ -242,13 +310,8 @@ class HalfCarDiagModel : public RigModel {
     for (auto& yc : y) delay(yc, tau_s, dt_);
   }
 
-  Indicator indicator(const std::string& cause) const override {
-    if (cause == "actuator_lag") return {"df_1/dt, commanded [N/s]", df1_};
-    if (cause == "tyre_liftoff") return {"lower tyre load / static load (from measured z_r - z_u)", load_};
-    if (cause == "damper_asymmetry") return {"corner-1 suspension rate [m/s] (from measured)", rate1_};
-    if (cause == "sensor_delay") return {"dz_u1/dt [m/s]", vu1_};
-    return {};
-  }
+
+ public:
   std::vector<double> effect_term(const std::string& cause, const std::vector<double>& th) const override {
     if (cause != "damper_asymmetry") return {};
     // Extra corner-1 damper force at the measured rate, over the spring rate:

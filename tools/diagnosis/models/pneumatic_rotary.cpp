@@ -216,6 +216,29 @@ class PneumaticRotaryModel : public RigModel {
     run(th, y, nullptr);
   }
 
+  // Where an effect can enter (docs/diagnosis.md 3); the order is run()'s
+  // `place`. Steps of the linearisation: a few per mille of the signals.
+  std::vector<Place> places() const override {
+    return {{"a torque on the rotor", "N m", 0.01, -1, false, {"bladder_hysteresis", "coulomb_friction"}},
+            {"a flow into the chambers (a rate of dp)", "Pa/s", 100.0, -1, false,
+             {"polytropic_exponent", "valve_deadband", "valve_null_offset"}},  // the valve's flow enters here
+            {"an offset of the valve command", "V", 1e-3, -1, false, {"valve_null_offset", "valve_deadband"}},
+            {"an error on the theta sensor (the feedback)", "rad", 1e-4, 0, true, {"sensor_delay"}},
+            {"an error on the dp sensor (fed back)", "Pa", 10.0, 1, true, {"sensor_delay"}}};
+  }
+  std::vector<Feature> features() const override {
+    // Outputs: theta 0, dp 1 (Feature::from).
+    return {{"omega", FeatureKind::kVelocity, omega_, {0}},
+            {"u", FeatureKind::kCommand, u_meas_, {0, 1}},  // the controller's law of theta and dp
+            {"dp", FeatureKind::kValue, outputs_[1].measured, {1}},
+            {"d(dp)/dt", FeatureKind::kValue, central_diff(moving_mean(outputs_[1].measured, 8), dt_), {1}},
+            {"theta", FeatureKind::kPosition, outputs_[0].measured, {0}}};
+  }
+  void simulate_with_input(const std::vector<double>& th, std::size_t place, const std::vector<double>& d,
+                           std::vector<std::vector<double>>& y) const override {
+    run(th, y, nullptr, 0, place, &d);
+  }
+
   Indicator indicator(const std::string& cause) const override {
     if (cause == "bladder_hysteresis" || cause == "coulomb_friction")
       return {"travel since the last reversal, signed by the direction [rad]", travel_};
@@ -239,8 +262,10 @@ class PneumaticRotaryModel : public RigModel {
 
  private:
   // which: 1 hysteresis torque, 2 Coulomb torque, into *torque per sample.
+  // d: the where's signal at places()[place], per sample (null: none).
   void run(const std::vector<double>& th, std::vector<std::vector<double>>& y, std::vector<double>* torque,
-           int which = 0) const {
+           int which = 0, std::size_t place = 0, const std::vector<double>* d = nullptr) const {
+    auto added = [&](std::size_t p, std::size_t k) { return d && place == p ? (*d)[k] : 0.0; };
     const double I = th[0], b = th[1], C1 = th[2], C2 = th[3], V = th[4], Pq = th[5], alpha = th[6], dither = th[7];
     const double hs = th[8], te = th[9], thr = std::max(th[10], 1e-4), tc = th[11], n_rest = th[12],
                  k_h = th[13], u0 = th[14], delta = th[15], tau = th[16];
@@ -294,14 +319,15 @@ class PneumaticRotaryModel : public RigModel {
       h_dp[k] = dp;
       h_fund[k] = fund_prev;  // the ripple at t_k comes from the opening over the period before it
       const double s = std::min(static_cast<double>(k), static_cast<double>(k) - shift);
-      const double theta_m = at(h_theta, s);
-      const double dp_m = at(h_dp, s) + ripple(k, at(h_fund, s), exponent(omega));
+      const double theta_m = at(h_theta, s) + added(3, k);
+      const double dp_m = at(h_dp, s) + ripple(k, at(h_fund, s), exponent(omega)) + added(4, k);
       y[0][k] = theta_m;
       y[1][k] = dp_m;
       sample.value[0] = theta_m;
       sample.value[1] = dp_m;
       ctrl.update(theta_d_[k], sample, cmd, terms);
-      const auto op = opening(cmd.value[0]);
+      const auto op = opening(cmd.value[0] + added(2, k));
+      const double torque_in = added(0, k), rate_in = added(1, k);
       fund_prev = A > 0.0 ? op.fundamental : 0.0;
       const double flow = 2.0 * C1 * p.solenoid_gain * op.mean;  // 2 C1 x_o [kg/s]
       // Each sub-step is split symmetrically (Strang): half a step of the
@@ -311,9 +337,9 @@ class PneumaticRotaryModel : public RigModel {
       // between angle and pressure that would pass for a sensor delay.
       for (int j = 0; j < kSubsteps; ++j) {
         const double n = exponent(omega);  // over the sub-step, at its start's speed
-        dp += 0.5 * h * n * (gas0 * flow - gas0 * C2 * dp - 2.0 * mot0 * omega);
+        dp += 0.5 * h * (n * (gas0 * flow - gas0 * C2 * dp - 2.0 * mot0 * omega) + rate_in);
         const double th_ = sign_like ? std::tanh(omega / kEps) : 0.0;
-        const double T = alpha * dp - te * z + stop_torque(theta + 0.5 * h * omega, omega);
+        const double T = alpha * dp - te * z + stop_torque(theta + 0.5 * h * omega, omega) + torque_in;
         // Semi-implicit in omega for the stiff tanh and the viscous term.
         const double slope = S / kEps * (1.0 - th_ * th_) + b;
         const double wn = omega + h * (T - S * th_ - b * omega) / (I + h * slope);
@@ -324,7 +350,7 @@ class PneumaticRotaryModel : public RigModel {
           const double e = std::exp(-a);
           z = z * e + (wm * h / thr) * (a > 1e-12 ? (1.0 - e) / a : 1.0 - 0.5 * a);
         }
-        dp += 0.5 * h * n * (gas0 * flow - gas0 * C2 * dp - 2.0 * mot0 * wn);
+        dp += 0.5 * h * (n * (gas0 * flow - gas0 * C2 * dp - 2.0 * mot0 * wn) + rate_in);
         omega = wn;
       }
       if (torque) {

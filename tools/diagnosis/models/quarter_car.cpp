@@ -76,6 +76,24 @@ enum : std::size_t {
   kParamCount
 };
 
+// Where an effect can enter (RigModel::places, docs/diagnosis.md 3): the
+// signal the "where" adds in simulate_with_input.
+enum PlaceIndex : std::size_t {
+  kOnBody, kOnWheel, kInSuspension,             // suspension sub-model: forces [N]
+  kOnRod, kOnSpool, kCrossPort, kIntoChamber1, kIntoChamber2,  // actuator: force, spool, flows
+  kSensorXr, kSensorXw,                          // sensors the model itself reads (in the loop, tyre input)
+  kModelPlaces
+};
+// What a place adds, per sample (Injection) and inside a sub-step (Extra).
+struct Injection {
+  std::size_t place;
+  const std::vector<double>* d;
+  double at(std::size_t p, std::size_t i) const { return place == p ? (*d)[i] : 0.0; }
+};
+struct Extra {
+  double rod = 0.0, spool = 0.0, cross = 0.0, q1 = 0.0, q2 = 0.0;
+};
+
 constexpr std::size_t kSuspensionParams[] = {kKs, kBd, kMb, kMw, kKt, kBt, kFc, kDFs, kD, kMu, kDc, kTau, kBb, kBw, kUni};
 constexpr std::size_t kActuatorParams[] = {kMb,  kMw,  kKt,  kBt,    kKv,    kTauR, kBetaNom, kRl, kPs,  kA1,
                                            kA2,  kBvr, kVd,  kUni,   kSealFm, kSealPc, kLeak, kDead, kAirFraction, kBw};
@@ -289,6 +307,68 @@ class QuarterCarModel : public RigModel {
       act_cache_.put(ka, std::vector<std::vector<double>>(first, first + static_cast<std::ptrdiff_t>(act_outputs_)));
     }
   }
+  std::vector<Place> places() const override {
+    // Steps of the linearisation: a few per mille of the signals there
+    // (body forces of hundreds of N, flows of 1e-5 m^3/s, a spool of 1).
+    std::vector<Place> p = {
+        {"a force on the body", "N", 1.0, -1, false, {"bearing_friction"}},
+        {"a force on the wheel", "N", 1.0, -1, false, {"tyre_liftoff"}},
+        {"a force between wheel and body (the suspension)", "N", 1.0, -1, false, {"damper_asymmetry"}},
+        {"a force on the rod", "N", 1.0, -1, false, {"actuator_seal_friction"}},
+        {"an error of the spool position (valve opening)", "1", 1e-4, -1, false, {"valve_deadband"}},
+        {"a flow from chamber 1 to chamber 2", "m^3/s", 1e-8, -1, false, {"cross_port_leakage"}},
+        {"a flow into chamber 1", "m^3/s", 1e-8, -1, false, {"entrained_air", "cross_port_leakage", "valve_deadband"}},
+        {"a flow into chamber 2", "m^3/s", 1e-8, -1, false, {"entrained_air", "cross_port_leakage", "valve_deadband"}},
+        {"an error on the x_r sensor (the feedback)", "m", 1e-5, 3, true, {"sensor_delay", "sensor_offset"}},
+        {"an error on the x_w sensor (also the tyre's input)", "m", 1e-5, 1, true, {"sensor_delay", "sensor_offset"}},
+        {"an error on the x_b sensor", "m", 1e-5, 0, false, {"sensor_delay", "sensor_offset"}}};
+    if (act_outputs_ > 2) {
+      p.push_back({"an error on the p1 sensor", "Pa", 1e3, 4, false, {}});
+      p.push_back({"an error on the p2 sensor", "Pa", 1e3, 5, false, {}});
+    }
+    if (!ft_.empty())
+      p.push_back({"an error on the f_t sensor", "N", 1.0, static_cast<int>(2 + act_outputs_), false, {"tyre_liftoff"}});
+    return p;
+  }
+  std::vector<Feature> features() const override {
+    std::vector<double> rel(vw_.size()), spring(vw_.size()), tyre(vw_.size());
+    for (std::size_t i = 0; i < rel.size(); ++i) {
+      rel[i] = vw_[i] - vb_[i];
+      spring[i] = xw_[i] - outputs_[0].measured[i];
+      tyre[i] = xr_[i] - xw_[i];
+    }
+    // Outputs: x_b 0, x_w 1, u 2, x_r 3, p1 4, p2 5 (Feature::from).
+    std::vector<Feature> f = {{"v_b", FeatureKind::kVelocity, vb_, {0}},
+                              {"v_w", FeatureKind::kVelocity, vw_, {1}},
+                              {"v_w - v_b", FeatureKind::kVelocity, rel, {0, 1}},
+                              {"v_r", FeatureKind::kVelocity, vr_, {3}},
+                              {"u", FeatureKind::kCommand, outputs_[2].measured, {2, 3}},  // PI of x_r
+                              {"x_b", FeatureKind::kPosition, outputs_[0].measured, {0}},
+                              {"x_r", FeatureKind::kPosition, xr_, {3}},
+                              {"x_w - x_b", FeatureKind::kValue, spring, {0, 1}},
+                              {"x_r - x_w", FeatureKind::kValue, tyre, {1, 3}}};
+    if (act_outputs_ > 2) {
+      const auto &p1 = outputs_[4].measured, &p2 = outputs_[5].measured;
+      std::vector<double> dp(p1.size());
+      for (std::size_t i = 0; i < dp.size(); ++i) dp[i] = p1[i] - p2[i];
+      f.push_back({"p1", FeatureKind::kValue, p1, {4}});
+      f.push_back({"p2", FeatureKind::kValue, p2, {5}});
+      f.push_back({"p1 - p2", FeatureKind::kValue, dp, {4, 5}});
+      f.push_back({"dp1/dt", FeatureKind::kValue, smooth_rate(p1), {4}});
+      f.push_back({"dp2/dt", FeatureKind::kValue, smooth_rate(p2), {5}});
+    }
+    return f;
+  }
+  void simulate_with_input(const std::vector<double>& th, std::size_t place, const std::vector<double>& d,
+                           std::vector<std::vector<double>>& y) const override {
+    simulate(th, y);  // the calibrated replay (from the cache), then the sub-model the place is in again
+    const Injection in{place, &d};
+    const bool suspension = place == kOnBody || place == kOnWheel || place == kInSuspension || place == kSensorXw;
+    const bool actuator = !suspension || place == kSensorXw;
+    const std::size_t ft = 2 + act_outputs_;
+    if (suspension) simulate_suspension(th, y[0], y[1], ft_.empty() ? nullptr : &y[ft], t_.size(), &in);
+    if (actuator) simulate_actuator(th, y, t_.size(), &in);
+  }
   Indicator indicator(const std::string& cause) const override {
     if (cause == "damper_asymmetry") {
       std::vector<double> r(vw_.size());
@@ -323,8 +403,18 @@ class QuarterCarModel : public RigModel {
 
  private:
   // yf: the tyre load (static part included), where the run has it.
+  // The rate of a noisy pressure over +-4 samples (20 ms): the +-1
+  // difference of a 0.2 bar transducer is 57 bar/s of noise.
+  std::vector<double> smooth_rate(const std::vector<double>& p) const {
+    std::vector<double> r(p.size(), 0.0);
+    for (std::size_t i = 4; i + 4 < p.size(); ++i) r[i] = (p[i + 4] - p[i - 4]) / (8.0 * dt_);
+    return r;
+  }
+
+  // yf: the tyre load (static part included), where the run has it. `in`:
+  // the where's signal at a suspension place (RigModel::simulate_with_input).
   void simulate_suspension(const std::vector<double>& th, std::vector<double>& yb, std::vector<double>& yw,
-                           std::vector<double>* yf, std::size_t samples) const {
+                           std::vector<double>* yf, std::size_t samples, const Injection* in = nullptr) const {
     const double ks = th[kKs], bd = th[kBd], Fc = th[kFc], dFs = th[kDFs], D = th[kD], mu = th[kMu], dc = th[kDc],
                  tau = th[kTau], b_b = th[kBb], b_w = th[kBw], uni = th[kUni];
     const std::size_t n = t_.size();
@@ -336,25 +426,27 @@ class QuarterCarModel : public RigModel {
     const BearingFrictionParams bp = p_.bearing_friction;
     double xw = xw_[0], xb = outputs_[0].measured[0], vw = vw_[0], vb = friction ? 0.0 : vb_[0];
     for (std::size_t i = 0; i < samples; ++i) {
+      const double f_body = in ? in->at(kOnBody, i) : 0.0, f_wheel = in ? in->at(kOnWheel, i) : 0.0,
+                   f_susp = in ? in->at(kInSuspension, i) : 0.0;
       yb[i] = xb + b_b;
-      yw[i] = xw + b_w;
+      yw[i] = xw + b_w + (in ? in->at(kSensorXw, i) : 0.0);
       const double xr0 = xr_[i], xr1 = i + 1 < n ? xr_[i + 1] : xr_[i];
       const double vr = (xr1 - xr0) / dt_;
       if (yf) (*yf)[i] = tyre_contact(f0 + kt * (xr0 - xw) + bt * (vr_load_[i] - vw), uni);
       for (int s = 0; s < sub; ++s) {
         const double xr = xr0 + (xr1 - xr0) * (s + 0.5) / sub;
         const double vrel = vw - vb;
-        const double fs = ks * (xw - xb) + (dc != 0.0 ? bd + dc * std::tanh(vrel / 0.01) : bd) * vrel;
+        const double fs = ks * (xw - xb) + (dc != 0.0 ? bd + dc * std::tanh(vrel / 0.01) : bd) * vrel + f_susp;
         const double ft = tyre_contact(f0 + kt * (xr - xw) + bt * (vr - vw), uni) - f0;  // static part removed
-        vw += h * (ft - fs) / mw;
+        vw += h * (ft - fs + f_wheel) / mw;
         xw += h * vw;
         if (friction) {
           double cn = Fc;
           if (mu > 0.0) cn += mu * bearing_friction_levels(bp, weight, fs, xw - xb).normal;
           const double c = cn + dFs * (vb == 0.0 ? 1.0 : std::exp(-(vb / 0.015) * (vb / 0.015)));
-          vb = implicit_velocity(mb, vb, fs, h, c, c, D, D);
+          vb = implicit_velocity(mb, vb, fs + f_body, h, c, c, D, D);
         } else {
-          vb += h * fs / mb;
+          vb += h * (fs + f_body) / mb;
         }
         xb += h * vb;
       }
@@ -373,15 +465,16 @@ class QuarterCarModel : public RigModel {
     double xs, p1, p2, xr, vr;
   };
 
-  void actuator_derivatives(const std::vector<double>& th, const Act& a, double u, double xw, double vw,
-                            Act& d) const {
+  void actuator_derivatives(const std::vector<double>& th, const Act& a, double u, double xw, double vw, Act& d,
+                            const Extra& x = {}) const {
     const auto& p = p_;
     d.xs = (u - a.xs) / th[kTauR];
     const double delta = th[kDead];
     // Overlapped spool: the metering edge opens delta later on either side.
-    const double spool = delta > 0.0 ? softplus(a.xs - delta, 0.002) - softplus(-a.xs - delta, 0.002) : a.xs;
+    const double xs = a.xs + x.spool;
+    const double spool = delta > 0.0 ? softplus(xs - delta, 0.002) - softplus(-xs - delta, 0.002) : xs;
     const ValveFlows q = valve_flows(spool, a.p1, a.p2, p.valve_flow_gain * th[kKv], th[kPs], p.laminar_pressure);
-    const double q_leak = (p.leakage ? (a.p1 - a.p2) / th[kRl] : 0.0) + th[kLeak] * (a.p1 - a.p2);
+    const double q_leak = (p.leakage ? (a.p1 - a.p2) / th[kRl] : 0.0) + th[kLeak] * (a.p1 - a.p2) + x.cross;
     // Free air: a bulk modulus that falls with the chamber's pressure
     // (kBubbleIndex: bubbles between isothermal and adiabatic).
     const double alpha = th[kAirFraction], beta_oil = th[kBetaNom];
@@ -390,8 +483,8 @@ class QuarterCarModel : public RigModel {
     const double a1 = th[kA1], a2 = th[kA2];
     const double v1 = std::max(th[kVd] + a1 * (a.xr - p.stroke_min), 1e-9);
     const double v2 = std::max(th[kVd] * p.dead_volume_rod / p.dead_volume_cap + a2 * (p.stroke_max - a.xr), 1e-9);
-    d.p1 = beta1 / v1 * (q.q1 - a1 * a.vr - q_leak);
-    d.p2 = beta2 / v2 * (a2 * a.vr + q_leak - q.q2);
+    d.p1 = beta1 / v1 * (q.q1 - a1 * a.vr - q_leak + x.q1);
+    d.p2 = beta2 / v2 * (a2 * a.vr + q_leak - q.q2 + x.q2);
     if (a.p1 <= p.cavitation_pressure && d.p1 < 0.0) d.p1 = 0.0;
     if (a.p2 <= p.cavitation_pressure && d.p2 < 0.0) d.p2 = 0.0;
     const double f0 = (th[kMb] + th[kMw]) * p.gravity;
@@ -399,11 +492,11 @@ class QuarterCarModel : public RigModel {
     // The seal's friction is not here: simulate_actuator applies it after
     // each sub-step, implicitly (it may be a sharp step).
     d.xr = a.vr;
-    d.vr = (a.p1 * a1 - a.p2 * a2 - th[kBvr] * a.vr - f_tyre - p.mass_rod * p.gravity) / p.mass_rod;
+    d.vr = (a.p1 * a1 - a.p2 * a2 - th[kBvr] * a.vr - f_tyre - p.mass_rod * p.gravity + x.rod) / p.mass_rod;
   }
 
-  void simulate_actuator(const std::vector<double>& th, std::vector<std::vector<double>>& y,
-                         std::size_t samples) const {
+  void simulate_actuator(const std::vector<double>& th, std::vector<std::vector<double>>& y, std::size_t samples,
+                         const Injection* in = nullptr) const {
     const std::size_t n = t_.size();
     const bool pressures = act_outputs_ > 2;
     PiController pi(pi_);
@@ -430,11 +523,12 @@ class QuarterCarModel : public RigModel {
       return Act{x.xs + k * d.xs, x.p1 + k * d.p1, x.p2 + k * d.p2, x.xr + k * d.xr, x.vr + k * d.vr};
     };
     for (std::size_t i = 0; i < samples; ++i) {
-      s.value[0] = a.xr;
+      const double xr_error = in ? in->at(kSensorXr, i) : 0.0;
+      s.value[0] = a.xr + xr_error;
       pi.update(xref_[i], s, c, terms);
       const double u = std::clamp(c.value[0], -1.0, 1.0);
       y[2][i] = u;
-      y[3][i] = a.xr;
+      y[3][i] = a.xr + xr_error;
       if (pressures) {
         y[4][i] = a.p1;
         y[5][i] = a.p2;
@@ -442,15 +536,19 @@ class QuarterCarModel : public RigModel {
       // The tyre load is driven by the wheel's true position: the measured
       // x_w less the candidate's transducer offset b_w (1840 N per 2 mm of
       // offset at kt, which the pressures show).
-      const double xw0 = xw_[i] - th[kBw], xw1 = (i + 1 < n ? xw_[i + 1] : xw_[i]) - th[kBw];
+      const double xw0 = xw_[i] - th[kBw] - (in ? in->at(kSensorXw, i) : 0.0);
+      const double xw1 = (i + 1 < n ? xw_[i + 1] : xw_[i]) - th[kBw] - (in ? in->at(kSensorXw, std::min(i + 1, n - 1)) : 0.0);
+      const Extra x = in ? Extra{in->at(kOnRod, i), in->at(kOnSpool, i), in->at(kCrossPort, i),
+                                 in->at(kIntoChamber1, i), in->at(kIntoChamber2, i)}
+                         : Extra{};
       const double vw = (xw1 - xw0) / dt_;
       for (int k = 0; k < sub; ++k) {
         const double xw = xw0 + (xw1 - xw0) * (k + 0.5) / sub;
         Act k1, k2, k3, k4;
-        actuator_derivatives(th, a, u, xw, vw, k1);
-        actuator_derivatives(th, axpy(a, 0.5 * h, k1), u, xw, vw, k2);
-        actuator_derivatives(th, axpy(a, 0.5 * h, k2), u, xw, vw, k3);
-        actuator_derivatives(th, axpy(a, h, k3), u, xw, vw, k4);
+        actuator_derivatives(th, a, u, xw, vw, k1, x);
+        actuator_derivatives(th, axpy(a, 0.5 * h, k1), u, xw, vw, k2, x);
+        actuator_derivatives(th, axpy(a, 0.5 * h, k2), u, xw, vw, k3, x);
+        actuator_derivatives(th, axpy(a, h, k3), u, xw, vw, k4, x);
         a.xs += h / 6.0 * (k1.xs + 2 * k2.xs + 2 * k3.xs + k4.xs);
         a.p1 += h / 6.0 * (k1.p1 + 2 * k2.p1 + 2 * k3.p1 + k4.p1);
         a.p2 += h / 6.0 * (k1.p2 + 2 * k2.p2 + 2 * k3.p2 + k4.p2);
