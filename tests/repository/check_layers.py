@@ -19,12 +19,13 @@ import sys
 LAYER_OF_FOLDER = {
     'rt': 'base',
     'rt/control': 'control', 'rt/safety': 'safety', 'rt/comms': 'comms', 'rt/loop': 'loop',
+    'rt/procedure': 'procedure',
     'plant': 'plant',
     'drivers': 'drivers',
     'foxglove': 'foxglove',
     'config': 'config',
     'tools/run': 'run', 'tools/cmd': 'run', 'tools/rig_sim': 'run', 'tools/runfile': 'run', 'tools/common': 'run',
-    'tools/bridge': 'run',
+    'tools/bridge': 'run', 'tools/procedure': 'run',
     'tools/hidden_effects': 'hidden_effects',
     'tools/diagnosis': 'diagnosis',
     'tools/suspension': 'suspension',
@@ -44,10 +45,13 @@ BELOW = {
     'control': {'base', 'plant'},
     'safety': {'base', 'plant'},
     'comms': {'base', 'plant', 'safety', 'lcmtypes'},
-    'loop': {'base', 'plant', 'control', 'safety', 'comms'},
+    # A test procedure (rt/procedure): a demand source with its counters,
+    # compensation and rainflow; the loop asks it on the tick.
+    'procedure': {'base', 'plant', 'control', 'safety'},
+    'loop': {'base', 'plant', 'control', 'safety', 'comms', 'procedure'},
     'drivers': {'base', 'plant'},
 }
-RT = {'control', 'safety', 'comms', 'loop'}
+RT = {'control', 'safety', 'comms', 'loop', 'procedure'}
 # The Foxglove server and MCAP (foxglove/): fed by comms' telemetry, read by
 # run; nothing in rt includes it, so the tick cannot depend on it.
 BELOW['foxglove'] = BELOW['comms'] | {'comms'}
