@@ -97,17 +97,17 @@ bool RainflowCounter::restore(const double* points, std::size_t n, bool has_pend
 // ---- matrix
 
 void RainflowMatrix::configure(double lo, double hi, double basquin_exponent, double reference_range) noexcept {
-  lo_ = lo;
-  hi_ = hi > lo ? hi : lo + 1.0;
-  exponent_ = basquin_exponent;
-  reference_ = reference_range > 0.0 ? reference_range : 1.0;
+  d_.lo = lo;
+  d_.hi = hi > lo ? hi : lo + 1.0;
+  d_.exponent = basquin_exponent;
+  d_.reference = reference_range > 0.0 ? reference_range : 1.0;
   reset();
 }
 
 void RainflowMatrix::reset() noexcept {
-  for (auto& row : counts_) row.fill(0.0);
-  total_ = 0.0;
-  damage_ = 0.0;
+  for (auto& row : d_.counts) row.fill(0.0);
+  d_.total = 0.0;
+  d_.damage = 0.0;
 }
 
 std::size_t RainflowMatrix::bin(double x, double lo, double width) noexcept {
@@ -117,17 +117,17 @@ std::size_t RainflowMatrix::bin(double x, double lo, double width) noexcept {
 }
 
 void RainflowMatrix::on_cycle(const RainflowCycle& c) noexcept {
-  counts_[bin(c.range(), 0.0, range_width())][bin(c.mean(), lo_, mean_width())] += c.count;
-  total_ += c.count;
-  damage_ += c.count * std::pow(c.range() / reference_, exponent_);
+  d_.counts[bin(c.range(), 0.0, range_width())][bin(c.mean(), d_.lo, mean_width())] += c.count;
+  d_.total += c.count;
+  d_.damage += c.count * std::pow(c.range() / d_.reference, d_.exponent);
 }
 
 void RainflowMatrix::add(const RainflowMatrix& other) noexcept {
   for (std::size_t i = 0; i < kBins; ++i) {
-    for (std::size_t j = 0; j < kBins; ++j) counts_[i][j] += other.counts_[i][j];
+    for (std::size_t j = 0; j < kBins; ++j) d_.counts[i][j] += other.d_.counts[i][j];
   }
-  total_ += other.total_;
-  damage_ += other.damage_;
+  d_.total += other.d_.total;
+  d_.damage += other.d_.damage;
 }
 
 void RainflowChannel::snapshot(RainflowMatrix& out) const noexcept {

@@ -91,11 +91,23 @@ class RainflowCounter {
 // rubber and forged parts). With the reference range the damage of one
 // cycle of that range is 1: the sum is "equivalent reference cycles", which
 // compares tests on the same part without knowing its S-N curve.
+// 32 bins each way: enough to see a block program's levels apart and small
+// enough to write at every block end (1024 counts).
+inline constexpr std::size_t kRainflowBins = 32;
+
+// The matrix's numbers as plain data (a recovery file holds them as bytes).
+struct RainflowMatrixData {
+  std::array<std::array<double, kRainflowBins>, kRainflowBins> counts{};
+  double lo = -1.0, hi = 1.0;
+  double exponent = 3.0;
+  double reference = 1.0;
+  double total = 0.0;
+  double damage = 0.0;
+};
+
 class RainflowMatrix final : public CycleSink {
  public:
-  // 32 bins each way: enough to see a block program's levels apart and small
-  // enough to write at every block end (1024 counts).
-  static constexpr std::size_t kBins = 32;
+  static constexpr std::size_t kBins = kRainflowBins;
 
   // Ranges from 0 to span, means from lo to hi (span = hi - lo). A cycle
   // outside is counted in the nearest bin (its damage is exact anyway).
@@ -103,34 +115,27 @@ class RainflowMatrix final : public CycleSink {
   void reset() noexcept;
   void on_cycle(const RainflowCycle& c) noexcept override;
 
-  double count(std::size_t range_bin, std::size_t mean_bin) const noexcept { return counts_[range_bin][mean_bin]; }
+  double count(std::size_t range_bin, std::size_t mean_bin) const noexcept { return d_.counts[range_bin][mean_bin]; }
   double range_bin_centre(std::size_t i) const noexcept { return (static_cast<double>(i) + 0.5) * range_width(); }
-  double mean_bin_centre(std::size_t j) const noexcept { return lo_ + (static_cast<double>(j) + 0.5) * mean_width(); }
-  double total_cycles() const noexcept { return total_; }
-  double damage() const noexcept { return damage_; }
-  double lo() const noexcept { return lo_; }
-  double hi() const noexcept { return hi_; }
-  double basquin_exponent() const noexcept { return exponent_; }
-  double reference_range() const noexcept { return reference_; }
+  double mean_bin_centre(std::size_t j) const noexcept { return d_.lo + (static_cast<double>(j) + 0.5) * mean_width(); }
+  double total_cycles() const noexcept { return d_.total; }
+  double damage() const noexcept { return d_.damage; }
+  double lo() const noexcept { return d_.lo; }
+  double hi() const noexcept { return d_.hi; }
+  double basquin_exponent() const noexcept { return d_.exponent; }
+  double reference_range() const noexcept { return d_.reference; }
   // Adds another matrix's counts and damage (committed + residue).
   void add(const RainflowMatrix& other) noexcept;
-  // Restores the totals of a resumed test (the bins are not carried over).
-  void restore_totals(double cycles, double damage) noexcept {
-    total_ = cycles;
-    damage_ = damage;
-  }
+  // The numbers, to save and restore (a resumed test).
+  const RainflowMatrixData& data() const noexcept { return d_; }
+  void set_data(const RainflowMatrixData& d) noexcept { d_ = d; }
 
  private:
-  double range_width() const noexcept { return (hi_ - lo_) / static_cast<double>(kBins); }
-  double mean_width() const noexcept { return (hi_ - lo_) / static_cast<double>(kBins); }
+  double range_width() const noexcept { return (d_.hi - d_.lo) / static_cast<double>(kBins); }
+  double mean_width() const noexcept { return (d_.hi - d_.lo) / static_cast<double>(kBins); }
   static std::size_t bin(double x, double lo, double width) noexcept;
 
-  std::array<std::array<double, kBins>, kBins> counts_{};
-  double lo_ = -1.0, hi_ = 1.0;
-  double exponent_ = 3.0;
-  double reference_ = 1.0;
-  double total_ = 0.0;
-  double damage_ = 0.0;
+  RainflowMatrixData d_;
 };
 
 // A channel's whole count: the counter and its committed matrix. `snapshot`
