@@ -10,10 +10,10 @@
 // file all continue the present step this way, at its interrupted cycle.
 //
 // Compensation (docs/procedures.md):
-//  * amplitude_phase: the feedback's fundamental is fitted per cycle
-//    (rt/procedure/sine_fit.hpp); after a measured cycle the command's gain,
-//    phase and mean move by `gain` x the error, blended in over the next
-//    cycle (no step in the demand), and the cycle after that is measured.
+//  * amplitude_phase: the feedback's fundamental is fitted over two cycles
+//    (rt/procedure/sine_fit.hpp); then the command's gain, phase and mean
+//    move by `gain` x the error, blended in over the next cycle (no step in
+//    the demand), and the two cycles after that are measured.
 //  * peak_valley: the feedback's turning points (hysteresis 10 % of the
 //    wanted range) against the wanted peak and valley of their row; the row's
 //    commanded end levels move by `gain` x the error. Every row keeps its
@@ -117,6 +117,8 @@ class ProcedureRunner {
   bool blending_ = false;
   double from_gain_ = 1.0, from_phase_ = 0.0, from_mean_ = 0.0;
   SineFit fit_;
+  static constexpr int kMeasuredCycles = 2;
+  int measured_cycles_ = 0;  // cycles in the present measurement
   // blocks: the end levels this cycle's halves run between
   double half_start_ = 0.0, half_end_ = 0.0;
   bool in_down_half_ = false;

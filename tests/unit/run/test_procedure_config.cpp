@@ -92,10 +92,18 @@ TEST(ProcedureConfig, ErrorsNameFileLineAndKey) {
   EXPECT_NE(error_of(unknown_kind).find("proc.yaml:3: steps[1].sinus: unknown step 'sinus' (known: ramp, hold, sine, blocks, drive, repeat)"),
             std::string::npos)
       << error_of(unknown_kind);
-  const std::string typo = "steps:\n  - sine:\n      mean: 0.08\n      amplitud: 0.01\n      frequency: 5\n      cycles: 10\n";
-  EXPECT_NE(error_of(typo).find("proc.yaml:" + std::to_string(test::line_of(typo, "amplitud")) + ": steps[0].sine"),
+  // A misspelt optional key is an unknown key at its own line; a missing
+  // required one is named at its mapping.
+  const std::string typo =
+      "steps:\n  - sine:\n      mean: 0.08\n      amplitude: 0.01\n      frequency: 5\n      cycles: 10\n"
+      "      compensaton: none\n";
+  EXPECT_NE(error_of(typo).find("proc.yaml:" + std::to_string(test::line_of(typo, "compensaton")) +
+                                ": steps[0].sine.compensaton: unknown key"),
             std::string::npos)
       << error_of(typo);
+  const std::string missing = "steps:\n  - sine:\n      mean: 0.08\n      amplitud: 0.01\n";
+  EXPECT_NE(error_of(missing).find("proc.yaml:3: steps[0].sine.amplitude: missing required key"), std::string::npos)
+      << error_of(missing);
   const std::string bad_comp =
       "steps:\n  - sine: {mean: 0, amplitude: 0.01, frequency: 5, cycles: 10, compensation: amplitude}\n";
   EXPECT_NE(error_of(bad_comp).find("steps[0].sine.compensation: unknown compensation 'amplitude' (known: none, amplitude_phase, peak_valley)"),
