@@ -249,6 +249,18 @@ ConfigReader ConfigReader::child(const std::string& key) {
   return ConfigReader(n, file_, path_of(key));
 }
 
+std::vector<ConfigReader> ConfigReader::items(const std::string& key) {
+  YAML::Node n = required(key);
+  if (!n.IsSequence()) fail_at(n, key, std::string("expected a list, got ") + kind_name(n));
+  std::vector<ConfigReader> out;
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    const std::string item = key + "[" + std::to_string(i) + "]";
+    if (!n[i].IsMap()) fail_at(n[i], item, std::string("expected a mapping of keys, got ") + kind_name(n[i]));
+    out.push_back(ConfigReader(n[i], file_, path_of(item)));
+  }
+  return out;
+}
+
 std::vector<std::string> ConfigReader::keys() const {
   std::vector<std::string> out;
   for (const auto& kv : node_) out.push_back(key_text(kv.first, *file_, path_));

@@ -57,6 +57,8 @@ class ConfigReader {
   std::vector<std::string> texts(const std::string& key,
                                  const std::function<void(const std::string&)>& check = {});
   ConfigReader child(const std::string& key);
+  // A list of mappings (a procedure's `steps:`), each read as `KEY[i]`.
+  std::vector<ConfigReader> items(const std::string& key);
   // Keys of a mapping child, in file order (for maps keyed by channel name).
   std::vector<std::string> keys() const;
 

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <string_view>
 
+#include "rt/procedure_status.hpp"
 #include "rt/rig_state.hpp"
 #include "rt/sample.hpp"
 #include "rt/timing_summary.hpp"
@@ -54,6 +55,9 @@ enum class EventCode : uint8_t {
   kStopTimeout,       // a controlled stop did not settle in time: valve made safe
   kLogWriteFailed,    // a log write failed (disk full, I/O error); the rig keeps running
   kFaultReset,        // every fault cleared and the latches were reset
+  // Test procedures (rt/procedure/procedure_runner.hpp).
+  kPeakValleyChange,   // input `channel`'s peaks/valleys left the step's reference (value = change, fraction of range)
+  kCompensationLimit,  // the compensation needed more than its max_factor (value = factor): something broke
 };
 
 constexpr std::string_view to_string(EventCode c) {
@@ -79,6 +83,8 @@ constexpr std::string_view to_string(EventCode c) {
     case EventCode::kStopTimeout: return "stop_timeout";
     case EventCode::kLogWriteFailed: return "log_write_failed";
     case EventCode::kFaultReset: return "fault_reset";
+    case EventCode::kPeakValleyChange: return "peak_valley_change";
+    case EventCode::kCompensationLimit: return "compensation_limit";
   }
   return "unknown";
 }
@@ -103,6 +109,8 @@ struct TelemetryRecord {
   SafetyState safety_state = SafetyState::kRunning;
   bool valve_enabled = true;  // false: the driver holds its safe command, `command` was not written
   Event event;
+  // A test procedure's step, counts and compensation (active: one runs).
+  ProcedureStatus procedure;
   // Set on the ticks where the loop publishes its timing statistics.
   bool has_timing = false;
   TimingSummary timing;

@@ -21,6 +21,7 @@
 #include "tools/tune/tune_command.hpp"
 #include "tools/runfile/log2csv.hpp"
 #include "tools/runfile/log2mcap.hpp"
+#include "tools/procedure/rainflow_files.hpp"
 #include "tools/runfile/run_file_rig.hpp"
 #include "tools/suspension/optimize_command.hpp"
 #include "tools/rig_sim/rig_sim.hpp"
@@ -79,6 +80,9 @@ int main(int argc, char** argv) {
   std::string run_ws;
   run_cmd->add_option("--ws", run_ws, "Serve the telemetry to Foxglove/Lichtblick on a WebSocket, [ADDR:]PORT (default address 127.0.0.1; port 0: any free port); overrides telemetry.websocket (docs/foxglove.md)");
   run_cmd->add_option("--catalog", run.catalog_path, "Run catalog to enter the run into (SQLite, created on first use); overrides the config's catalog.path (docs/rig-health.md)");
+  run_cmd->add_option("--procedure", run.procedure_path, "Run a test procedure (sine, blocks, drive, repeat; docs/procedures.md)")->check(CLI::ExistingFile);
+  run_cmd->add_option("--resume", run.resume_path, "Continue the procedure from its recovery file (after a crash, kill or power cut)")->check(CLI::ExistingFile);
+  run_cmd->add_option("--recovery", run.recovery_path, "Where the procedure's recovery file is written (default: <log>.recovery)");
   run_cmd->add_option("--fault", run_fault_texts, "Inject a fault in the simulated driver, KIND@TIME[:ARG...] (stuck, rail, noise, nan, offset, overrun, supply, burst; SAFETY.md); repeatable");
 
   std::string log_in, csv_out, prefix = "RIGCTL_";
@@ -92,6 +96,14 @@ int main(int argc, char** argv) {
   l2m->add_option("log", mcap_in, "LCM log written by rigctl run")->required();
   l2m->add_option("mcap", mcap_out, "MCAP file to write")->required();
   l2m->add_option("--channel-prefix", mcap_prefix, "Telemetry channel prefix used by the run");
+
+  rigctl::RainflowFileOptions rainflow;
+  auto* rainflow_cmd = app.add_subcommand("rainflow", "Rainflow count (ASTM E1049) and pseudo-damage of a recorded run's channel (docs/procedures.md)");
+  rainflow_cmd->add_option("run", rainflow.run_path, "Run file (CSV) or a run's LCM log (.lcm)")->required()->check(CLI::ExistingFile);
+  rainflow_cmd->add_option("--channel", rainflow.channel, "Column to count, e.g. x_r")->required();
+  rainflow_cmd->add_option("--matrix", rainflow.matrix_path, "Write the range-mean matrix as CSV");
+  rainflow_cmd->add_option("--basquin", rainflow.basquin_exponent, "Basquin exponent of the pseudo-damage")->capture_default_str()->check(CLI::PositiveNumber);
+  rainflow_cmd->add_option("--reference-range", rainflow.reference_range, "Range of unit damage (default: the largest range)")->check(CLI::PositiveNumber);
 
   rigctl::BridgeOptions bridge;
   std::string bridge_ws;
@@ -444,6 +456,7 @@ int main(int argc, char** argv) {
       install_stop_handlers();
       return rigctl::run_bridge(bridge, g_stop, std::cout);
     }
+    if (rainflow_cmd->parsed()) return rigctl::run_rainflow_command(rainflow, std::cout);
     if (l2c->parsed()) {
       const auto result = rigctl::log_to_csv(log_in, csv_out, prefix);
       std::cout << "log2csv: " << result.rows << " rows of " << result.rig << " written to " << csv_out;

@@ -147,6 +147,10 @@ class QuarterCarPlant : public SimulatedPlant {
   void set_chamber_leak(int chamber, double k) noexcept {
     if (chamber == 1 || chamber == 2) chamber_leak_[static_cast<std::size_t>(chamber - 1)] = k;
   }
+  // Test hook: the specimen (the suspension spring) softens during a
+  // durability test (tests/procedure: the peak-valley change detector).
+  // reset() does not undo it.
+  void set_spring_stiffness(double k) noexcept { params_.spring_stiffness = k; }
 
   // The continuous model advance() integrates, for other integrators (the
   // benchmark's adaptive reference, tools/bench/reference.cpp) so that they

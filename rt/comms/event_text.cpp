@@ -86,6 +86,11 @@ std::string event_message(const Event& ev, const ChannelLayout& layout) {
     case EventCode::kStopTimeout: return "controlled stop did not settle in time: valve made safe";
     case EventCode::kLogWriteFailed: return "log write failed (value = errno " + format_g(ev.value) + ")";
     case EventCode::kFaultReset: return "faults reset";
+    case EventCode::kPeakValleyChange:
+      return channel + " peaks/valleys changed by " + format_g(100.0 * ev.value) + " % of the reference range" +
+             action_suffix(ev);
+    case EventCode::kCompensationLimit:
+      return "compensation needed a factor " + format_g(ev.value) + ", beyond its limit: step stopped" + action_suffix(ev);
   }
   return "unknown event";
 }

@@ -19,6 +19,7 @@
 #include "rigctl/controller_t.hpp"
 #include "rigctl/driver_status_t.hpp"
 #include "rigctl/sample_t.hpp"
+#include "rigctl/procedure_t.hpp"
 #include "rigctl/state_t.hpp"
 #include "rigctl/timing_t.hpp"
 
@@ -227,6 +228,44 @@ void TelemetryPublisher::publish_reports() {
   for (const auto& [event, message] : reports) publish_state_event(event, message, log_failures_.load() == 0);
 }
 
+// A procedure's state when its counts, step or phase change, and every 40th
+// tick (0.1 s at 2.5 ms) between: a console sees it move without a message
+// per tick in the log.
+void TelemetryPublisher::publish_procedure(const TelemetryRecord& r, int64_t utime, double t) {
+  const ProcedureStatus& s = r.procedure;
+  const bool changed = s.total_cycles != last_procedure_.total_cycles || s.step != last_procedure_.step ||
+                       s.phase != last_procedure_.phase || s.ramp_in_cycles != last_procedure_.ramp_in_cycles ||
+                       s.pass != last_procedure_.pass;
+  if (!changed && r.tick % 40 != 0) return;
+  last_procedure_ = s;
+  rigctl::procedure_t m;
+  m.utime = utime;
+  m.tick = r.tick;
+  m.t = t;
+  m.step = s.step;
+  m.phase = std::string(to_string(s.phase));
+  m.step_cycles = s.step_cycles;
+  m.total_cycles = s.total_cycles;
+  m.ramp_in_cycles = s.ramp_in_cycles;
+  m.row = s.row;
+  m.row_cycles = s.row_cycles;
+  m.pass = s.pass;
+  m.wanted = s.wanted;
+  m.comp_gain = s.comp_gain;
+  m.comp_phase = s.comp_phase;
+  m.comp_mean = s.comp_mean;
+  m.comp_peak = s.comp_peak;
+  m.comp_valley = s.comp_valley;
+  m.amplitude_error = s.amplitude_error;
+  m.phase_error = s.phase_error;
+  m.peak_error = s.peak_error;
+  m.valley_error = s.valley_error;
+  m.peak = s.peak;
+  m.valley = s.valley;
+  m.damage = s.damage;
+  note_log_result(emit(*lcm_, log_.get(), taps_, channels_.procedure, utime, m));
+}
+
 std::optional<TelemetryRecord> TelemetryPublisher::latest() const {
   std::lock_guard<std::mutex> lock(latest_mutex_);
   return latest_;
@@ -303,6 +342,7 @@ void TelemetryPublisher::publish_record(const TelemetryRecord& r) {
     k.saturated = r.controller.saturated;
     k.integrator_held = r.controller.integrator_held;
     note_log_result(emit(*lcm_, log, taps_, channels_.controller, utime, k));
+    if (r.procedure.active) publish_procedure(r, utime, t);
   }
 
   if (first_record_ || r.state != last_state_ || r.safety_state != last_safety_state_ ||

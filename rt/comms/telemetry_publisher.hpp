@@ -51,10 +51,10 @@ struct TelemetryMeta {
 
 // LCM channel names, given the prefix.
 struct TelemetryChannels {
-  std::string sample, command, controller, timing, state, driver;
+  std::string sample, command, controller, timing, state, driver, procedure;
   explicit TelemetryChannels(const std::string& prefix)
       : sample(prefix + "SAMPLE"), command(prefix + "COMMAND"), controller(prefix + "CONTROLLER"),
-        timing(prefix + "TIMING"), state(prefix + "STATE"), driver(prefix + "DRIVER") {}
+        timing(prefix + "TIMING"), state(prefix + "STATE"), driver(prefix + "DRIVER"), procedure(prefix + "PROCEDURE") {}
 };
 
 class TelemetryPublisher final : public TelemetrySink {
@@ -103,6 +103,7 @@ class TelemetryPublisher final : public TelemetrySink {
  private:
   void thread_main();
   void publish_record(const TelemetryRecord& record);
+  void publish_procedure(const TelemetryRecord& record, int64_t utime, double t);
   void publish_driver_status();
   void publish_reports();
   void publish_state_event(const std::string& event, const std::string& message, bool to_log);
@@ -129,6 +130,7 @@ class TelemetryPublisher final : public TelemetrySink {
   std::mutex reports_mutex_;
   std::vector<std::pair<std::string, std::string>> reports_;
   bool first_record_ = true;
+  ProcedureStatus last_procedure_{};  // the procedure state last published
   bool stopped_ = false;
 };
 

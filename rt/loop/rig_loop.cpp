@@ -31,6 +31,13 @@ RigLoop::RigLoop(Driver& driver, Controller& controller, FilteredProfile& profil
       telemetry_(telemetry), clock_(clock), options_(options), safety_(safety),
       machine_(with_period(safety.machine, options.period_ns)), timing_(options.period_ns, options.overrun_policy) {}
 
+void RigLoop::set_procedure(ProcedureRunner* procedure, RecoverySink* recovery, int64_t recovery_every_ticks) {
+  procedure_ = procedure;
+  recovery_sink_ = recovery;
+  recovery_every_ticks_ = recovery_every_ticks;
+  if (recovery_sink_ != nullptr) recovery_ = std::make_unique<ProcedureRecovery>();
+}
+
 LoopResult RigLoop::run(const std::atomic<bool>& stop_requested) {
   RunState run;
   begin_run(run);
@@ -96,6 +103,7 @@ RigLoop::Step RigLoop::read(RunState& run) {
   run.record = TelemetryRecord{};
   run.record.tick = run.tick;
   run.command_event = Event{};
+  run.procedure_trip = Event{};
   if (!driver_.read(run.record.sample)) {
     run.end_event = Event{EventCode::kDriverReadFailed, -1, 0.0};
     run.ended_by_fault = true;
@@ -137,7 +145,9 @@ const DetectorResult& RigLoop::judge_limits(RunState& run) noexcept {
 
 RigLoop::Step RigLoop::step_state_machine(const DetectorResult& trips, RunState& run) noexcept {
   MachineInputs in;
-  in.limit_action = trips.action;
+  // The procedure's own trips (peak-valley change, compensation limit) act
+  // like a detector's, latched until a reset.
+  in.limit_action = procedure_ != nullptr ? more_severe(trips.action, procedure_->action()) : trips.action;
   in.faults_present = trips.faults_present;
   in.feedback_valid = !trips.feedback_invalid;
   in.feedback = run.record.sample.value[static_cast<std::size_t>(run.feedback_input)];
@@ -192,6 +202,7 @@ CommandResult RigLoop::apply_command(const OperatorCommand& c, EventSource sourc
 void RigLoop::on_accepted(const OperatorCommand& c, EventSource source, const CommandResult& r, RunState& run) noexcept {
   if (r.reset_latches) {
     detectors_.clear_latches();
+    if (procedure_ != nullptr) procedure_->clear_latch();
     run.worst_trip = Event{};
   }
   switch (c.kind) {
@@ -199,8 +210,17 @@ void RigLoop::on_accepted(const OperatorCommand& c, EventSource source, const Co
     case OperatorCommandKind::kStop:
       if (source == EventSource::kOperator) run.operator_stopped = true;
       break;
+    case OperatorCommandKind::kResume:
+      // A procedure continues its step from where the hold left the demand.
+      if (procedure_ != nullptr) procedure_->start(run.previous_demand);
+      break;
     case OperatorCommandKind::kStart:
       run.operator_stopped = false;  // a new test after a re-arm
+      if (procedure_ != nullptr) {
+        // A procedure is not restarted: it continues (or begins) from here.
+        procedure_->start(run.previous_demand);
+        break;
+      }
       // The profile from its beginning: its clock restarts at this sample.
       profile_.reset();
       run.profile_clock.restart_at(run.t_ns());
@@ -233,7 +253,8 @@ void RigLoop::demand(RunState& run) noexcept {
   if (run.tick > 0 && !machine_.profile_clock_running()) run.profile_clock.freeze_for(run.t_ns() - run.previous_t_ns);
   run.demand = run.previous_demand;
   if (!run.valve_enabled) return;
-  const double profile = machine_.demand_mode() == DemandMode::kProfile ? profile_value(run) : 0.0;
+  const bool profile_mode = machine_.demand_mode() == DemandMode::kProfile;
+  const double profile = !profile_mode ? 0.0 : procedure_ != nullptr ? procedure_value(run) : profile_value(run);
   run.demand = machine_.next_demand(profile);
 }
 
@@ -246,6 +267,30 @@ double RigLoop::profile_value(RunState& run) noexcept {
     events_.log_state_changes(machine_, run.tick, run.t_ns());
   }
   return value;
+}
+
+// One tick of the procedure; a trip of its own is logged as it happens and
+// acts through the state machine on the next tick's check.
+double RigLoop::procedure_value(RunState& run) noexcept {
+  const double value = procedure_->next(run.record.sample, run.feedback);
+  Event trip;
+  if (procedure_->new_trip(trip)) {
+    if (trip.action > run.worst_trip.action) run.worst_trip = trip;
+    events_.log(loop_event(run.tick, run.t_ns(), machine_.state(), trip));
+    run.procedure_trip = trip;
+  }
+  return value;
+}
+
+// The recovery when a cycle, pass or step ended, and at least every
+// recovery_every_ticks while the procedure runs.
+void RigLoop::offer_recovery(RunState& run) noexcept {
+  if (recovery_sink_ == nullptr || (procedure_->finished() && !procedure_->recovery_due())) return;
+  const bool periodic = recovery_every_ticks_ > 0 && run.tick - last_recovery_tick_ >= recovery_every_ticks_;
+  if (!procedure_->recovery_due() && !periodic) return;
+  procedure_->recovery(*recovery_);
+  recovery_sink_->offer(*recovery_);
+  last_recovery_tick_ = run.tick;
 }
 
 // ---- control + write
@@ -274,6 +319,10 @@ void RigLoop::hand_off(RunState& run) noexcept {
   r.safety_state = machine_.state();
   r.valve_enabled = run.valve_enabled;
   r.event = record_event(run);
+  if (procedure_ != nullptr) {
+    r.procedure = procedure_->status();
+    offer_recovery(run);
+  }
   const bool timing_due = options_.timing_every_ticks > 0 && (run.tick + 1) % options_.timing_every_ticks == 0;
   emit(r, timing_due);  // its timing figures are those of the ticks before this one
   // The tick's compute ends when the publisher has the record: a hand-off
@@ -293,7 +342,8 @@ void RigLoop::hand_off(RunState& run) noexcept {
 Event RigLoop::record_event(const RunState& run) const noexcept {
   if (run.tick == 0) return Event{EventCode::kRunStarted, -1, 0.0};
   const DetectorResult& trips = detectors_.last();
-  return trips.new_count > 0 ? trips.worst_new.event() : run.command_event;
+  if (trips.new_count > 0) return trips.worst_new.event();
+  return run.procedure_trip.code != EventCode::kNone ? run.procedure_trip : run.command_event;
 }
 
 void RigLoop::emit(TelemetryRecord& record, bool with_timing) noexcept {
@@ -305,7 +355,8 @@ void RigLoop::emit(TelemetryRecord& record, bool with_timing) noexcept {
 // ---- end of run
 
 RigLoop::Step RigLoop::decide_end(RunState& run) noexcept {
-  if (run.tick + 1 >= options_.max_ticks && !run.run_length_reached) stop_at_run_length(run);
+  const bool procedure_done = procedure_ != nullptr && procedure_->finished();
+  if ((run.tick + 1 >= options_.max_ticks || procedure_done) && !run.run_length_reached) stop_at_run_length(run);
   // Operator mode ends when the operator has stopped the rig and then turned
   // the hydraulics off: the test is over and the rig is safe.
   const bool operator_done = !safety_.auto_sequence && run.operator_stopped && machine_.state() == SafetyState::kOff;

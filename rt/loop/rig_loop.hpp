@@ -21,6 +21,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <memory>
 
 #include "rt/comms/event_sink.hpp"
 #include "rt/comms/telemetry_sink.hpp"
@@ -31,6 +32,8 @@
 #include "rt/loop/loop_events.hpp"
 #include "rt/loop/run_state.hpp"
 #include "rt/loop_clock.hpp"
+#include "rt/procedure/procedure_runner.hpp"
+#include "rt/procedure/recovery_sink.hpp"
 #include "rt/safety/limit_detectors.hpp"
 #include "rt/safety/operator_command.hpp"
 #include "rt/safety/rig_state_machine.hpp"
@@ -81,6 +84,11 @@ class RigLoop {
   // LCM receiver pushes them) and the durable event log.
   void set_operator_commands(SpscQueue<OperatorCommand>* commands) { commands_.attach_operator_queue(commands); }
   void set_event_sink(EventSink* events) { events_.attach(events); }
+  // A test procedure gives the demand instead of the profile, its trips act
+  // like the detectors', its end ends the run; its recoveries go to
+  // `recovery` (may be nullptr) at every cycle, pass and step end and at
+  // least every recovery_every_ticks.
+  void set_procedure(ProcedureRunner* procedure, RecoverySink* recovery, int64_t recovery_every_ticks);
 
   // Runs until the rig is stopped (max_ticks or stop_requested: a controlled
   // stop) or faulted (automatic sequence). stop_requested is set from a
@@ -119,6 +127,8 @@ class RigLoop {
   Event record_event(const RunState& run) const noexcept;
   void stop_at_run_length(RunState& run) noexcept;
   void emit(TelemetryRecord& record, bool with_timing) noexcept;
+  double procedure_value(RunState& run) noexcept;
+  void offer_recovery(RunState& run) noexcept;
 
   Driver& driver_;
   Controller& controller_;
@@ -133,6 +143,11 @@ class RigLoop {
   CommandSources commands_;
   LoopEvents events_;
   int64_t dropped_ = 0;  // telemetry records the sink refused
+  ProcedureRunner* procedure_ = nullptr;
+  RecoverySink* recovery_sink_ = nullptr;
+  int64_t recovery_every_ticks_ = 0;
+  int64_t last_recovery_tick_ = 0;
+  std::unique_ptr<ProcedureRecovery> recovery_;  // the hand-off's scratch, allocated before the run
 };
 
 }  // namespace rigctl

@@ -38,6 +38,7 @@ struct RunState {
   bool valve_enabled = false;  // the valve is driven this tick (after the commands)
   double demand = 0.0;         // this tick's demand; the previous one while the valve is not driven
   Event command_event{};       // this tick's operator or signal command, accepted or refused: the record shows it
+  Event procedure_trip{};      // this tick's new trip of the test procedure (peak-valley change, compensation limit)
 
   int64_t t_ns() const noexcept { return record.sample.t_ns; }  // rig time of this tick's sample
 

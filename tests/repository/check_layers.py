@@ -19,6 +19,7 @@ import sys
 LAYER_OF_FOLDER = {
     'rt': 'base',
     'rt/control': 'control', 'rt/safety': 'safety', 'rt/comms': 'comms', 'rt/loop': 'loop',
+    'rt/procedure': 'procedure',
     'plant': 'plant',
     'drivers': 'drivers',
     'foxglove': 'foxglove',
@@ -26,6 +27,7 @@ LAYER_OF_FOLDER = {
     'tools/run': 'run', 'tools/cmd': 'run', 'tools/rig_sim': 'run', 'tools/runfile': 'run', 'tools/common': 'run',
     'tools/bridge': 'run',
     'tools/catalog': 'run',  # the run catalog: `rigctl run` enters its runs (docs/rig-health.md)
+    'tools/procedure': 'run',
     'tools/hidden_effects': 'hidden_effects',
     'tools/diagnosis': 'diagnosis',
     'tools/health': 'health',  # windows of long runs, trends, change detection, make-series
@@ -46,10 +48,13 @@ BELOW = {
     'control': {'base', 'plant'},
     'safety': {'base', 'plant'},
     'comms': {'base', 'plant', 'safety', 'lcmtypes'},
-    'loop': {'base', 'plant', 'control', 'safety', 'comms'},
+    # A test procedure (rt/procedure): a demand source with its counters,
+    # compensation and rainflow; the loop asks it on the tick.
+    'procedure': {'base', 'plant', 'control', 'safety'},
+    'loop': {'base', 'plant', 'control', 'safety', 'comms', 'procedure'},
     'drivers': {'base', 'plant'},
 }
-RT = {'control', 'safety', 'comms', 'loop'}
+RT = {'control', 'safety', 'comms', 'loop', 'procedure'}
 # The Foxglove server and MCAP (foxglove/): fed by comms' telemetry, read by
 # run; nothing in rt includes it, so the tick cannot depend on it.
 BELOW['foxglove'] = BELOW['comms'] | {'comms'}

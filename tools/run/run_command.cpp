@@ -29,6 +29,7 @@
 #include "tools/run/rig_assembly.hpp"
 #include "tools/run/run_catalog.hpp"
 #include "tools/run/service_notify.hpp"
+#include "tools/procedure/procedure_run.hpp"
 
 namespace rigctl {
 
@@ -128,7 +129,8 @@ struct RunLength {
 // or a signal, unless --duration bounds it.
 RunLength run_length(const AssembledRig& rig, const RunOptions& options, bool operator_run) {
   RunLength l;
-  l.unbounded = operator_run && !options.duration_s;
+  // A procedure ends the run itself (or a trip holds it until --duration).
+  l.unbounded = (operator_run || !options.procedure_path.empty()) && !options.duration_s;
   l.duration_s = options.duration_s.value_or(l.unbounded ? 0.0 : rig.profile_duration_s);
   if (!l.unbounded && !(l.duration_s > 0.0)) throw std::runtime_error("run duration must be positive");
   return l;
@@ -251,6 +253,20 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
   RunReport report;
   report.log_path = options.log_path.empty() ? default_log_path(config.telemetry.log_dir, std::string(to_string(config.rig))) : options.log_path;
   report.csv_path = options.csv_path;
+  std::unique_ptr<ProcedureRun> procedure;
+  ProcedureRunOptions po;
+  if (!options.procedure_path.empty()) {
+    po.procedure_path = options.procedure_path;
+    po.resume_path = options.resume_path;
+    po.recovery_path = options.recovery_path.empty() ? report.log_path + ".recovery" : options.recovery_path;
+    po.config_path = options.config_path;
+    po.case_name = options.case_name;
+    po.fast = options.fast;
+    po.period_s = config.loop.period_s;
+    procedure = open_procedure_run(po, rig.driver->layout(), std::max(0, rig.safety.feedback_input));
+  } else if (!options.resume_path.empty()) {
+    throw std::runtime_error("--resume continues a procedure: give its --procedure too");
+  }
   const TelemetryMeta meta = telemetry_meta_for(config, rig, loop_options, options.fast);
   const std::string url = options.lcm_url.empty() ? config.telemetry.lcm_url : options.lcm_url;
   // Ten seconds of records: a paced run's publisher thread would have to
@@ -310,7 +326,9 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
   // The one way down, after the loop or on its failure: the receiver before
   // the event log (its last rejections go in), the logs kept (what was
   // recorded stays), the driver last (the valve stays safe until then).
+  if (procedure) procedure->writer->start();
   auto stop_services = [&](const char* why) {
+    if (procedure) procedure->writer->stop();  // its last recovery written
     notifier.stop(why);
     if (receiver) receiver->stop();
     events.stop();
@@ -326,6 +344,7 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
       RunCatalogContext{run_catalog_path(config, options.catalog_path), options.config_path, options.case_name,
                         static_cast<bool>(options.profile_override)},
       report.log_path, meta.start_utime, out);
+  if (procedure) print_procedure_header(*procedure, po, out);
 
   MonotonicClock monotonic;
   VirtualClock virtual_clock;
@@ -353,6 +372,7 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
                  rig.safety);
     loop.set_event_sink(&events);
     loop.set_operator_commands(commands);
+    if (procedure) loop.set_procedure(procedure->runner.get(), procedure->writer.get(), procedure->recovery_every_ticks);
     try {
       result = loop.run(stop);
     } catch (...) {
@@ -368,6 +388,7 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
   report.end_reason = end_reason(result.end_event, meta.layout, *rig.driver);
 
   print_run_summary(config, options, report, *rig.driver, out);
+  if (procedure) print_procedure_summary(*procedure, out);
   print_run_records(report, publisher, events, receiver.get(), foxglove_server.get(), out);
   // A signal's stop is the operator's interruption; a trip that held or
   // stopped the rig made it faulted (rt/loop/rig_loop.cpp finish_run).

@@ -57,6 +57,12 @@ struct RunOptions {
   // all, is the config's.
   std::function<std::unique_ptr<SetpointProfile>()> profile_override;
   std::function<std::unique_ptr<Controller>(const ChannelLayout&)> controller_override;
+  // --procedure PROC.yaml: a test procedure gives the demand and ends the run
+  // (docs/procedures.md); --resume RECOVERY continues one; the recovery is
+  // written to recovery_path (default: <log>.recovery).
+  std::string procedure_path;
+  std::string resume_path;
+  std::string recovery_path;
 };
 
 struct RunReport {

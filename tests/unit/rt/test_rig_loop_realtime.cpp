@@ -10,6 +10,7 @@
 #include "allocation_counter.hpp"
 #include "rt/control/pi_controller.hpp"
 #include "rt/loop/rig_loop.hpp"
+#include "rt/procedure/procedure_runner.hpp"
 
 using namespace rigctl;
 using K = OperatorCommandKind;
@@ -127,8 +128,10 @@ struct Rig {
     return LimitDetectors({invalid, indicate, hold}, 1, 0, kT);
   }
 
-  // Counts the heap allocations of run() alone.
-  long run_counting_allocations(bool auto_sequence, int64_t max_ticks, LoopResult& result) {
+  // Counts the heap allocations of run() alone; with a procedure (and a
+  // recovery sink) when given.
+  long run_counting_allocations(bool auto_sequence, int64_t max_ticks, LoopResult& result,
+                                ProcedureRunner* procedure = nullptr, RecoverySink* recovery = nullptr) {
     LoopOptions o;
     o.period_ns = kPeriod;
     o.max_ticks = max_ticks;
@@ -142,6 +145,7 @@ struct Rig {
     RigLoop loop(driver, pi, profile, detectors(), sink, clock, o, s);
     loop.set_event_sink(&events);
     loop.set_operator_commands(&queue);
+    if (procedure != nullptr) loop.set_procedure(procedure, recovery, 400);
     const long before = rigctl::test::allocation_count();
     result = loop.run(stop);
     return rigctl::test::allocation_count() - before;
@@ -189,4 +193,59 @@ TEST(RigLoopRealtime, ABurstOfOperatorCommandsIsSpreadOverTicks) {
   EXPECT_EQ(rig.events.commands_at_tick[1], kMax);
   EXPECT_EQ(rig.events.commands_at_tick[2], 20 - 2 * kMax);
   EXPECT_EQ(rig.events.commands_at_tick[3], 0);
+}
+
+// Takes every recovery the loop offers into storage of its own.
+class CopyingRecovery final : public RecoverySink {
+ public:
+  void offer(const ProcedureRecovery& r) noexcept override {
+    *last = r;
+    ++offers;
+  }
+  std::unique_ptr<ProcedureRecovery> last = std::make_unique<ProcedureRecovery>();
+  int64_t offers = 0;
+};
+
+// A procedure on the tick: a ramp, a compensated sine, a peak_valley block
+// program with the rainflow count and the peak-valley detector, a repeat
+// group and a hold, with recoveries at every cycle: no allocation, and its
+// end ends the run.
+TEST(RigLoopRealtime, AProcedureRunAllocatesNothing) {
+  Rig rig;
+  ProcedureSpec spec;
+  spec.ramp_rate = 0.02;
+  spec.rainflow_channels = {0};
+  StepSpec ramp;
+  ramp.kind = StepKind::kRamp;
+  ramp.level = 0.05;
+  ramp.rate = 0.02;
+  StepSpec sine;
+  sine.kind = StepKind::kSine;
+  sine.rows = {{0.05, 0.004, 2.0, 6}};
+  sine.compensation.kind = Compensation::kAmplitudePhase;
+  sine.peak_valley = PeakValleyDetectorSpec{true, 0, 1, 2, 0.5, 3, LimitAction::kIndicate};
+  StepSpec blocks;
+  blocks.kind = StepKind::kBlocks;
+  blocks.rows = {{0.05, 0.003, 1.0, 3}, {0.052, 0.002, 2.0, 3}};
+  blocks.repeats = 2;
+  blocks.compensation.kind = Compensation::kPeakValley;
+  blocks.has_end_level = true;
+  blocks.end_level = 0.04;
+  StepSpec begin, end, hold;
+  begin.kind = StepKind::kRepeatBegin;
+  begin.repeats = 2;
+  end.kind = StepKind::kRepeatEnd;
+  hold.kind = StepKind::kHold;
+  hold.time_s = 0.5;
+  spec.steps = {ramp, begin, sine, blocks, end, hold};
+  ProcedureRunner procedure(spec, kT, 0);
+  CopyingRecovery recovery;
+  LoopResult result;
+  EXPECT_EQ(rig.run_counting_allocations(true, 1'000'000, result, &procedure, &recovery), 0);
+  EXPECT_TRUE(procedure.finished());
+  EXPECT_EQ(procedure.status().total_cycles, spec.programmed_cycles());
+  EXPECT_EQ(result.end_event.code, EventCode::kProfileFinished);
+  EXPECT_GT(recovery.offers, spec.programmed_cycles());
+  EXPECT_EQ(recovery.last->status.phase, ProcedurePhase::kDone);
+  EXPECT_LT(result.ticks, 1'000'000) << "the procedure's end ended the run";
 }
