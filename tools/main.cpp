@@ -151,6 +151,7 @@ int main(int argc, char** argv) {
   diag_cmd->add_flag("--drop-bad-rows", diag.drop_bad_rows, "Drop (and count) rows with bad cells instead of failing");
   diag_cmd->add_option("--decimate", diag.decimate, "Keep every Nth sample (default: the rig's choice)");
   diag_cmd->add_flag("--quiet", diag.quiet, "No progress on stderr");
+  diag_cmd->add_option("--threads", diag.threads, "Threads of the whole diagnosis (default 2)")->check(CLI::Range(1, 64));
 
   rigctl::MakeRunOptions make;
   std::string make_rig;

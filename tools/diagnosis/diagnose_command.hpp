@@ -17,6 +17,7 @@ struct DiagnoseCommandOptions {
   bool drop_bad_rows = false;
   int decimate = 0;  // 0: the rig's default
   bool quiet = false;
+  int threads = 2;  // --threads: of the whole diagnosis (docs/diagnosis.md 4)
 };
 
 // Returns the exit code: 0 with a diagnosis (including `none`), 2 for bad

@@ -79,4 +79,25 @@ inline ParamSpec StandsFor(ParamSpec p, const std::string& cause, int toward) {
   return p;
 }
 
+// An effect's parameter that acts on one sensor channel (ParamSpec::channel).
+inline ParamSpec OnChannel(ParamSpec p, const std::string& channel) {
+  p.channel = channel;
+  return p;
+}
+
+// The effect's form index (ParamSpec::form), starting at form 0.
+inline ParamSpec FormIndex() {
+  ParamSpec p = P("form", "1", 0.0, 0.0, 1e3, 1.0, 0.0);
+  p.form = true;
+  return p;
+}
+
+// A baseline parameter of the loop's I/O timing [s] within [0, hi]
+// (ParamSpec::timing), starting at `init`.
+inline ParamSpec Timing(const std::string& name, double init, double hi, double scale) {
+  ParamSpec p = P(name, "s", init, 0.0, hi, scale);
+  p.timing = true;
+  return p;
+}
+
 }  // namespace rigctl::diag
