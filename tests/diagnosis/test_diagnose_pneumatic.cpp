@@ -122,7 +122,7 @@ Sizes sizes(const diag::CauseResult& c, const test::HiddenRun& run) {
   if (c.cause == "polytropic_exponent") return {1.4 - param(c, "n"), 1.4 - tr("n")};
   if (c.cause == "valve_null_offset") return {param(c, "u0"), tr("u0")};
   if (c.cause == "valve_deadband") return {param(c, "delta"), tr("delta")};
-  if (c.cause == "sensor_delay") return {param(c, "tau"), tr("tau")};
+  if (c.cause == "sensor_delay") return {param(c, "tau_theta"), tr("tau")};  // the generator delays theta and dp alike
   ADD_FAILURE() << "no size comparison for " << c.cause;
   return {NAN, NAN};
 }

@@ -65,8 +65,8 @@ constexpr double kNearTieShare = 0.1;
 // A parameter that stands for a cause ended at its band's edge when it is
 // within this share of a tolerance of it.
 constexpr double kBandEdgeShare = 0.05;
-// Iterations of a candidate's refit in each of its forms, its own
-// parameters only: enough to rank the forms from the screened start.
+// Iterations of a candidate's refit in each of its forms: enough to rank
+// the forms from the screened start.
 constexpr int kFormIterations = 6;
 
 // ------------------------------------------------------------ calibration
@@ -231,10 +231,12 @@ bool strength_significant(const Workspace& w, std::size_t e, const Scored& s) {
   return false;
 }
 
-// A candidate of several forms (EffectSpec::forms): its own parameters
-// refitted briefly in each form from the screened start, the form with the
-// lowest estimation cost kept in the returned start (the screening ran the
-// first form). One form: the start unchanged.
+// A candidate of several forms (EffectSpec::forms): its parameters and the
+// baseline's it couples to refitted briefly in each form from the screened
+// start, the form with the lowest estimation cost kept in the returned start
+// (the screening ran the first form). Its own parameters alone were not
+// enough: the screened baseline had bent to the first form (a Bessel filter
+// was taken for one of order 3). One form: the start unchanged.
 std::vector<double> best_form(const Workspace& w, std::size_t e, std::vector<double> start,
                               std::map<std::string, double>& costs) {
   const auto& eff = w.effects[e];
@@ -242,8 +244,7 @@ std::vector<double> best_form(const Workspace& w, std::size_t e, std::vector<dou
   for (std::size_t j = 0; j < eff.params.size(); ++j)
     if (eff.params[j].form) form = j;
   if (form == eff.params.size() || eff.forms.size() < 2) return start;
-  std::vector<bool> own(w.specs.size(), false);
-  for (std::size_t j = 0; j < eff.params.size(); ++j) own[w.offset[e] + j] = !eff.params[j].form;
+  const std::vector<bool> own = coupled_free(w, {e});
   std::vector<Scored> fits(eff.forms.size());
   parallel_for(w.threads, fits.size(), [&](std::size_t f, std::size_t) {
     auto s = start;

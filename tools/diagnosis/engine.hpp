@@ -22,7 +22,7 @@ struct ParamValue {
   double value = 0.0;
   double sigma = 0.0;
   bool determined = true;  // false: the run cannot determine it; the JSON writes null and lists it as undetermined
-  std::string channel;     // the sensor channel it acts on (ParamSpec::channel), or empty
+  std::string channel = {};  // the sensor channel it acts on (ParamSpec::channel), or empty
 };
 
 // A baseline parameter after the calibration: where it started (the
