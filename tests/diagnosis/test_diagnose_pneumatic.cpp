@@ -34,6 +34,7 @@
 
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <iterator>
 #include <map>
@@ -222,6 +223,48 @@ TEST(DiagnosePneumatic, CleanRunIsNone) {
   // to within the sensors' noise and quantisation.
   EXPECT_GT(out[0].d.baseline_fit_percent.at("theta"), 98.0);
   EXPECT_GT(out[0].d.baseline_fit_percent.at("dp"), 97.0);
+}
+
+// The same clean rig recorded on another time base: every time stamp 5 ms
+// later, a quarter of the 50 Hz dither's period, so the dither's ripple sits
+// 90 degrees from where phase 0 would put it (a rig whose dither does not
+// start with the record). That is the rig's timing, not a cause: the phase
+// is read off the record's ripple (-pi/2), the fit is the clean run's, and
+// nothing is named. The loop's I/O timing is reported within its bounds.
+TEST(DiagnosePneumatic, ACleanRunOnAnotherTimeBaseIsCalibratedNotAccused) {
+  const test::HiddenRun run = make_run_file({"clean_shifted", {}, 0});
+  std::ifstream in(run.csv);
+  const std::string shifted = ::testing::TempDir() + "/pneu_clean_shifted_t.csv";
+  std::ofstream out(shifted);
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#' || line[0] == 't') {
+      out << line << "\n";
+      continue;
+    }
+    const auto comma = line.find(',');
+    char t[32];
+    std::snprintf(t, sizeof t, "%.6f", std::stod(line.substr(0, comma)) + 0.005);
+    out << t << line.substr(comma) << "\n";
+  }
+  out.close();
+  const auto rf = read_run_file(shifted, run_file_columns(RunFileRig::kPneumaticRotary));
+  diag::RigModelOptions mo;
+  mo.config_path = kConfig;
+  const auto model = diag::make_rig_model(RunFileRig::kPneumaticRotary, rf, mo);
+  const double phase = model->constants().at("dither_phase_rad");
+  EXPECT_NEAR(std::remainder(phase + M_PI / 2.0, 2.0 * M_PI), 0.0, 0.15) << phase;
+  const auto d = diag::diagnose(*model, {});
+  EXPECT_EQ(d.cause, "none") << summary(d);
+  EXPECT_GT(d.baseline_fit_percent.at("dp"), 97.0);
+  int timing = 0;
+  for (const auto& c : d.calibration)
+    if (c.timing) {
+      ++timing;
+      EXPECT_GE(c.value, c.lo) << c.name;
+      EXPECT_LE(c.value, c.hi) << c.name;
+      EXPECT_LE(c.hi, 2.0 * 0.0025 + 1e-12) << c.name;  // at most two periods
+    }
+  EXPECT_EQ(timing, 2);  // t_command and t_sample
 }
 
 // Through the program, as a user runs it: JSON and the HTML report.

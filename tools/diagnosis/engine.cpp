@@ -232,9 +232,9 @@ bool strength_significant(const Workspace& w, std::size_t e, const Scored& s) {
 }
 
 // A candidate of several forms (EffectSpec::forms): its parameters and the
-// baseline's it couples to refitted briefly in each form from the screened
-// start, the form with the lowest estimation cost kept in the returned start
-// (the screening ran the first form). Its own parameters alone were not
+// baseline's it couples to refitted briefly in each form from `start`, the
+// form with the lowest estimation cost returned as a start for its refit
+// (`start` itself where that is the form it has). Its own parameters alone were not
 // enough: the screened baseline had bent to the first form (a Bessel filter
 // was taken for one of order 3). One form: the start unchanged.
 std::vector<double> best_form(const Workspace& w, std::size_t e, std::vector<double> start,
@@ -257,24 +257,19 @@ std::vector<double> best_form(const Workspace& w, std::size_t e, std::vector<dou
     if (fits[f].est_sse < fits[best].est_sse) best = f;
   }
   w.say("  " + eff.cause + ": form " + eff.forms[best] + " fits best");
+  if (static_cast<double>(best) == start[w.offset[e] + form]) return start;  // the form it has
   return fits[best].theta;
 }
 
 // Full refit of one screened candidate, judged against the current model
 // (every candidate of the round at the same N_eff, neff).
-Candidate refit_one(const Workspace& w, const Candidate& screened, const Scored& current,
-                    const std::vector<std::size_t>& active, double neff, int round) {
-  Candidate r;
-  r.effect = screened.effect;
+// Judges the refitted candidate r (r.effect and r.s set) against the current
+// model: its signal, gain and standard error, and the gates' verdict.
+void judge(const Workspace& w, Candidate& r, const Scored& current, const std::vector<std::size_t>& active,
+           double neff) {
   const std::string& cause = w.effects[r.effect].cause;
-  w.say("round " + std::to_string(round) + ": refitting " + cause);
   auto act = active;
   act.push_back(r.effect);
-  // The baseline parameters the kept and the new effects couple to are
-  // free; the others stay where the calibration put them (their
-  // sub-model's outputs do not change with the candidate).
-  r.s = fit_coupled(w, best_form(w, r.effect, screened.s.theta, r.form_costs), act, kRefitIterations, current);
-  w.say("  " + cause + ": refitted in " + std::to_string(r.s.iterations) + " iterations");
   // Its signal: the largest gain among the outputs where it reaches its
   // floor (a delay may gain most on dp but explain the misfit of theta),
   // else the largest gain.
@@ -306,7 +301,37 @@ Candidate refit_one(const Workspace& w, const Candidate& screened, const Scored&
   r.excess_before = ev.excess_before;
   r.excess_after = ev.excess_after;
   r.floor = gain_floor(ev, w.options);
-  return r;
+}
+
+// Full refit of one screened candidate, judged against the current model
+// (every candidate of the round at the same N_eff, neff). A candidate of
+// several forms is refitted in its first form; only where that reaches its
+// gain floor are its forms ranked (best_form) and, where another fits
+// better, refitted in that one and judged again: the forms are what the
+// JSON reports of a named cause, and ranking them for every candidate that
+// is then rejected doubled a quarter-car round.
+Candidate refit_one(const Workspace& w, const Candidate& screened, const Scored& current,
+                    const std::vector<std::size_t>& active, double neff, int round) {
+  Candidate r;
+  r.effect = screened.effect;
+  const std::string& cause = w.effects[r.effect].cause;
+  w.say("round " + std::to_string(round) + ": refitting " + cause);
+  auto act = active;
+  act.push_back(r.effect);
+  // The baseline parameters the kept and the new effects couple to are
+  // free; the others stay where the calibration put them (their
+  // sub-model's outputs do not change with the candidate).
+  r.s = fit_coupled(w, screened.s.theta, act, kRefitIterations, current);
+  w.say("  " + cause + ": refitted in " + std::to_string(r.s.iterations) + " iterations");
+  judge(w, r, current, active, neff);
+  if (w.effects[r.effect].forms.size() < 2 || r.gain < r.floor) return r;
+  const auto start = best_form(w, r.effect, r.s.theta, r.form_costs);
+  if (start == r.s.theta) return r;
+  Candidate other = r;
+  other.s = fit_coupled(w, start, act, kRefitIterations, current);
+  if (!(other.s.est_sse < r.s.est_sse)) return r;
+  judge(w, other, current, active, neff);
+  return other;
 }
 
 // Full refit of the best few, side by side on the workers (they are
