@@ -144,8 +144,11 @@ TEST(DiagnosisSensorForms, TheDiagnosisNamesTheLateChannelAndTheFilterItIsBehind
     for (const auto& [f, cost] : c.form_costs) costs += " " + f + " " + std::to_string(cost);
     EXPECT_EQ(c.form, to_string(form)) << costs;
     EXPECT_EQ(c.channels, std::vector<std::string>{"b"}) << to_string(form);
-    for (const auto& p : c.parameters)
-      if (p.name == "tau_b") EXPECT_NEAR(p.value, 0.015, 0.0015) << to_string(form);
+    for (const auto& p : c.parameters) {
+      if (p.name == "tau_b") {
+        EXPECT_NEAR(p.value, 0.015, 0.0015) << to_string(form);
+      }
+    }
     EXPECT_EQ(c.form_costs.size(), kSensorForms.size());
   }
 }
