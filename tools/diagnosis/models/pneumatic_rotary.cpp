@@ -43,10 +43,11 @@
 //  * coulomb_friction: (T_c + dT_s exp(-(omega / 0.01 rad/s)^2)) tanh(omega /
 //    eps): a full jump at the reversal, flat in travel, with a stiction
 //    excess to break away from rest (the plant's brake is exact stick/slip).
-//  * polytropic_exponent: the chamber gas compressed with exponent n (null
-//    1.4, adiabatic) and exchanging heat with the walls through hA (Newton's
-//    law, null 0): a temperature state per chamber (their difference; the
-//    sum stays at rest as the pressure sum does). With the net mass flow dm
+//  * polytropic_exponent, in two forms: the chamber gas exchanging heat with
+//    the walls through hA (Newton's law, null 0; the gas's exponent n stays
+//    1.4), a temperature state per chamber (their difference; the sum stays
+//    at rest as the pressure sum does), or compressed with a constant
+//    exponent n (null 1.4, no thermal state). With the net mass flow dm
 //    into chamber a and out of b and the volume rate 2 alpha omega:
 //      d(dp)/dt = n (R T / V dm - 2 Pq alpha / V omega) - (1.4 - 1) hA vth / V
 //      d(vth)/dt = T (d(dp)/dt / Pq + 2 alpha omega / V - R T dm / (Pq V))
@@ -65,8 +66,8 @@
 //
 // The loop's I/O timing is calibration, not a cause (docs/diagnosis.md 4):
 // t_command (the command takes effect that long after its sample: a
-// computation delay and the output's hold, up to two periods) and t_sample
-// (the sensors are sampled that long before the tick, up to one period) are
+// computation delay, up to a period, beside the hold) and t_sample (the
+// sensors are sampled that long before the tick, up to half a period) are
 // baseline parameters fitted within their bounds; only a sensor's delay
 // beyond what they explain is a sensor_delay.
 #include <algorithm>
@@ -111,7 +112,7 @@ enum : std::size_t {
   kTCmd, kTSample,                             // baseline: the loop's I/O timing
   kHs, kTe, kThetaR,                           // bladder_hysteresis
   kTc, kDTs,                                   // coulomb_friction
-  kN, kHA,                                     // polytropic_exponent
+  kN, kHA, kGasForm,                           // polytropic_exponent
   kU0,                                         // valve_null_offset
   kDelta,                                      // valve_deadband
   kTauTheta, kTauDp, kSensorFormIndex,         // sensor_delay
@@ -212,13 +213,16 @@ class PneumaticRotaryModel : public RigModel {
             Prior("alpha", "m^3/rad", p.first_moment, 0.05),
             Prior("dither", "V", std::max(p.dither_amplitude, 1e-3), 0.05),
             // The loop's I/O timing (docs/diagnosis.md 4): when the command
-            // takes effect after its sample (a computation delay and the
-            // output's hold: up to two periods), and how long before the tick
-            // the sensors are sampled (within one period). A rig's own, not
-            // a cause: calibrated within these bounds, from rigctl's own
-            // convention (sampled at the tick, applied at once).
-            Timing("t_command", 0.0, 2.0 * dt_, 0.5 * dt_),
-            Timing("t_sample", 0.0, dt_, 0.5 * dt_)};
+            // takes effect after its sample (a computation delay, up to a
+            // period), and how long before the tick the sensors are sampled
+            // (up to half a period). With the output's hold (half a period
+            // on average, in the replay) the loop's delay can grow by up to
+            // two periods. A rig's own, not a cause: calibrated within these
+            // bounds from rigctl's own convention (sampled at the tick,
+            // applied at once). Wider (two periods and one) they took 7.5 ms
+            // of a 10 ms sensor delay, leaving it 0.5 pp.
+            Timing("t_command", 0.0, dt_, 0.5 * dt_),
+            Timing("t_sample", 0.0, 0.5 * dt_, 0.5 * dt_)};
   }
   std::vector<EffectSpec> effects() const override {
     return {
@@ -237,11 +241,18 @@ class PneumaticRotaryModel : public RigModel {
          // of a chamber (m c_v = Pq V / ((1.4 - 1) T), about 1 J/K) follows
          // its walls in m c_v / hA: 10 ms at 100 W/K (near isothermal at
          // any motion of the rig), 1 s at 1 W/K.
+         // Two forms that do not nest: with heat exchange the gas's own
+         // exponent stays 1.4 and hA sets how far from adiabatic it gets (a
+         // large hA is isothermal whatever n, so n and hA free together
+         // traded against each other: n 1.11 for a world of constant 1.0);
+         // a constant exponent n has no thermal state. Each form's other
+         // parameter is unused (undetermined).
          {P("n", "1", 1.3, 0.8, 1.8, 0.2, 1.4, true, {1.05}),
-          P("hA", "W/K", 2.0, 0.0, 100.0, 5.0, 0.0, true, {20.0})},
-         "the chamber gas: compressed with exponent n (1.4 adiabatic, 1 isothermal) and exchanging heat with the "
-         "walls through hA (Newton's law; a temperature state per chamber): the pressure rate and the pneumatic "
-         "stiffness fall from adiabatic toward isothermal as the motion slows"},
+          P("hA", "W/K", 2.0, 0.0, 100.0, 5.0, 0.0, true, {20.0}), FormIndex()},
+         "the chamber gas: exchanging heat with the walls through hA (Newton's law; a temperature state per "
+         "chamber), so the pressure rate and the pneumatic stiffness fall from adiabatic toward isothermal as the "
+         "motion slows; or compressed with a constant exponent n (1.4 adiabatic, 1 isothermal)",
+         {"heat_exchange", "constant_exponent"}},
         {"valve_null_offset",
          {P("u0", "V", 0.05, -2.0, 2.0, 0.1, 0.0, true, {-0.1})},
          "valve null offset u0 added to the command before the spool (drift of the neutral)"},
@@ -340,8 +351,8 @@ class PneumaticRotaryModel : public RigModel {
     const Gas gas{p.gas_constant * p.supply_temperature / V,
                   th[kPq] * alpha / V,
                   th[kC2],
-                  th[kN],
-                  th[kHA],
+                  th[kGasForm] > 0.5 ? th[kN] : kAdiabaticExponent,  // constant_exponent : heat_exchange
+                  th[kGasForm] > 0.5 ? 0.0 : th[kHA],
                   V,
                   th[kPq],
                   p.supply_temperature,

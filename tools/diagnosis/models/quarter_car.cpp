@@ -204,11 +204,11 @@ class QuarterCarModel : public RigModel {
             Prior("V_dead", "m^3", p.dead_volume_cap, 0.05),
             // The actuator loop's I/O timing (docs/diagnosis.md 4): the
             // command takes effect t_command after its sample (a computation
-            // delay and the output's hold, up to two periods); the sensors
-            // are sampled t_sample before the tick (up to one period). The
-            // rig's own, calibrated from rigctl's convention (sampled at the
-            // tick, applied at once), never a cause.
-            Timing("t_command", 0.0, 2.0 * dt_, 0.5 * dt_), Timing("t_sample", 0.0, dt_, 0.5 * dt_)};
+            // delay, up to a period, beside the output's hold); the sensors
+            // are sampled t_sample before the tick (up to half a period).
+            // The rig's own, calibrated from rigctl's convention (sampled at
+            // the tick, applied at once), never a cause.
+            Timing("t_command", 0.0, dt_, 0.5 * dt_), Timing("t_sample", 0.0, 0.5 * dt_, 0.5 * dt_)};
   }
   std::vector<EffectSpec> effects() const override {
     return {
