@@ -173,6 +173,7 @@ class PneumaticRotaryModel : public RigModel {
     // the record's own dp ripple (dither_phase_from_ripple).
     const auto stated = run.meta_number("dither_phase_rad");
     dither_phase_ = stated ? *stated : dither_phase_from_ripple(W);
+    dither_phase_read_ = !stated;
     dither_phase_source_ = stated ? "stated in the run file" : "read off the record's dp ripple";
     for (double t : t_) {
       sin_.push_back(std::sin(W * t + dither_phase_));
@@ -369,8 +370,15 @@ class PneumaticRotaryModel : public RigModel {
     const double sample_back = th[kTSample] / dt_;
     const SensorForm form = sensor_form_at(th[kSensorFormIndex]);
     SensorFilter sense_theta(form, th[kTauTheta], dt_), sense_dp(form, th[kTauDp], dt_);
+    // The ripple's phase in the record is the sum of the dither's, the
+    // sampling's and the dp sensor's: a phase read off the record holds all
+    // three, so then the sensor and the sampling add no turn of their own
+    // (they would count twice: a 10 ms delay turned the ripple by another
+    // half period and gained 0.5 pp); only a stated dither phase leaves
+    // theirs to the model. The sensor's gain at 50 Hz applies either way.
     const auto dp_response = sense_dp.response(W);
-    const double ripple_gain = std::abs(dp_response), ripple_turn = std::arg(dp_response) - W * th[kTSample];
+    const double ripple_gain = std::abs(dp_response);
+    const double ripple_turn = dither_phase_read_ ? 0.0 : std::arg(dp_response) - W * th[kTSample];
     const double cr = std::cos(ripple_turn), sr = std::sin(ripple_turn);
     // dp ripple of a fundamental F [V] of the opening: 2 n R T/V C1 k F (a sin - W cos) / (W^2 + a^2),
     // a = n R T / V C2 (1 / tau_chamber), its phase turned by the sampling and the sensor.
@@ -539,6 +547,7 @@ class PneumaticRotaryModel : public RigModel {
   std::string source_;
   double dither_phase_ = 0.0, theta0_ = 0.0, dp0_ = 0.0;
   std::string dither_phase_source_;
+  bool dither_phase_read_ = false;  // off the record's ripple, sensor and sampling included
   std::size_t dp0_window_ = 1;
   std::vector<Output> outputs_;
 };
