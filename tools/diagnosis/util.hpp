@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "tools/diagnosis/model.hpp"
@@ -85,9 +86,11 @@ inline ParamSpec OnChannel(ParamSpec p, const std::string& channel) {
   return p;
 }
 
-// The effect's form index (ParamSpec::form), starting at form 0.
-inline ParamSpec FormIndex() {
-  ParamSpec p = P("form", "1", 0.0, 0.0, 1e3, 1.0, 0.0);
+// The effect's form index (ParamSpec::form), starting at form 0; `screened`:
+// further forms the screening starts from as well (a form the first cannot
+// stand in for, as a start grid does for a non-convex scalar).
+inline ParamSpec FormIndex(std::vector<double> screened = {}) {
+  ParamSpec p = P("form", "1", 0.0, 0.0, 1e3, 1.0, 0.0, false, std::move(screened));
   p.form = true;
   return p;
 }

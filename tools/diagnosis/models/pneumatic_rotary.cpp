@@ -247,9 +247,11 @@ class PneumaticRotaryModel : public RigModel {
          // large hA is isothermal whatever n, so n and hA free together
          // traded against each other: n 1.11 for a world of constant 1.0);
          // a constant exponent n has no thermal state. Each form's other
-         // parameter is unused (undetermined).
+         // parameter is unused (undetermined). Both forms are screened: an
+         // isothermal gas of constant exponent was not among the best three
+         // when screened as heat exchange alone.
          {P("n", "1", 1.3, 0.8, 1.8, 0.2, 1.4, true, {1.05}),
-          P("hA", "W/K", 2.0, 0.0, 100.0, 5.0, 0.0, true, {20.0}), FormIndex()},
+          P("hA", "W/K", 2.0, 0.0, 100.0, 5.0, 0.0, true, {20.0}), FormIndex({1.0})},
          "the chamber gas: exchanging heat with the walls through hA (Newton's law; a temperature state per "
          "chamber), so the pressure rate and the pneumatic stiffness fall from adiabatic toward isothermal as the "
          "motion slows; or compressed with a constant exponent n (1.4 adiabatic, 1 isothermal)",
