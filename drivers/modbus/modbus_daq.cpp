@@ -129,6 +129,7 @@ void ModbusDaq::start(double first_sample_timeout_s) {
   make_safe();  // no stale command from a previous run; the loop is not running yet
   io_->current = never_read();
   outputs_written_ns_ = 0;
+  cycles_requested_ = cycles_done_ = lock_step_reads_ = 0;
   thread_ = std::thread([this] { run_io(); });
   if (config_.io_priority > 0) {
     // Set from here, so a refusal (not root, no rtprio limit) is reported
@@ -155,13 +156,40 @@ void ModbusDaq::start(double first_sample_timeout_s) {
 
 void ModbusDaq::stop() {
   if (!thread_.joinable()) return;
-  stop_requested_ = true;
+  {
+    std::lock_guard lock(step_mutex_);
+    stop_requested_ = true;
+  }
+  step_cv_.notify_all();
   thread_.join();
+}
+
+void ModbusDaq::run_one_cycle() noexcept {
+  std::unique_lock lock(step_mutex_);
+  const int64_t wanted = ++cycles_requested_;
+  step_cv_.notify_all();
+  step_cv_.wait(lock, [&] { return cycles_done_ >= wanted || stop_requested_.load(); });
+}
+
+bool ModbusDaq::wait_for_cycle_request() noexcept {
+  std::unique_lock lock(step_mutex_);
+  step_cv_.wait(lock, [&] { return cycles_requested_ > cycles_done_ || stop_requested_.load(); });
+  return !stop_requested_.load();
+}
+
+void ModbusDaq::cycle_done() noexcept {
+  {
+    std::lock_guard lock(step_mutex_);
+    cycles_done_ = cycles_requested_;
+  }
+  step_cv_.notify_all();
 }
 
 int64_t ModbusDaq::read_inputs(Sample& out, std::size_t first_index, int64_t now) noexcept {
   const std::size_t n = config_.inputs.size();
   if (first_index + n > kMaxInputs) return std::numeric_limits<int64_t>::max();
+  // Lock-step: the first read takes start()'s sample, each later one a cycle of its own.
+  if (config_.lock_step && lock_step_reads_++ > 0) run_one_cycle();
   const InputSnapshot& s = inputs_.read();
   const int64_t max_age = to_ns(config_.max_sample_age_s);
   int64_t oldest = 0;
@@ -410,7 +438,11 @@ void ModbusDaq::run_io() noexcept {
 
   auto cycle = [&] {
     const int64_t t0 = now_ns();
-    bool ok = true;
+    // Lock-step: the previous tick's command goes out before the inputs are
+    // read, so the far side steps its plant with it before it answers.
+    const bool first_sample_was = first_sample_.load();
+    bool ok = !config_.lock_step || !first_sample_was || write_blocks(outputs_.read());
+    if (!ok) return;
     bool go_on = true;
     for (std::size_t b = 0; b < io.read_plan.blocks.size() && go_on; ++b) {
       const int64_t sent = now_ns();
@@ -440,7 +472,7 @@ void ModbusDaq::run_io() noexcept {
       }
     }
     if (!go_on) return;
-    ok = write_blocks(outputs_.read()) && ok;
+    if (!config_.lock_step || !first_sample_was) ok = write_blocks(outputs_.read()) && ok;
     if (!ok) return;
     const int64_t took = now_ns() - t0;
     std::lock_guard lock(mutex_);
@@ -450,9 +482,16 @@ void ModbusDaq::run_io() noexcept {
 
   int64_t next = now_ns();
   while (!stop_requested_.load()) {
+    // Lock-step: once the first sample is in, a cycle only when the loop asks.
+    const bool requested = config_.lock_step && first_sample_.load();
+    if (requested && !wait_for_cycle_request()) break;
     if (!io.link.is_open() && now_ns() >= io.next_connect_ns) try_connect();
     const bool ran = io.link.is_open();
     if (ran) cycle();
+    if (requested) {
+      cycle_done();
+      continue;
+    }
     next += period;
     const int64_t now = now_ns();
     if (now > next) {

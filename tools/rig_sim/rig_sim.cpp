@@ -7,6 +7,7 @@
 #include <memory>
 #include <random>
 #include <stdexcept>
+#include <thread>
 
 #include "config/config_reader.hpp"
 #include "config/rig_config.hpp"
@@ -157,6 +158,154 @@ class FaultSchedule {
   std::ostream& out_;
 };
 
+// The plant on the far side of the wire: it takes the valve command from the
+// wire (the DAQ's holding register, with the module's output watchdog, or the
+// CANopen valve's spool), steps, and puts its transducers' readings into the
+// DAQ's registers. Free-running, rig-sim's main thread calls it once per
+// period by the clock; in lock-step the DAQ's server thread calls it once
+// per exchange. Either way one thread at a time.
+class RigSimPlant {
+ public:
+  RigSimPlant(const RigConfig& config, const ModbusDaqConfig& daq_config, const RigSimOptions& o, SimModbusDaq& daq,
+              SimCanopenValve* valve, FaultSchedule& faults, std::ostream& out)
+      : config_(config), daq_config_(daq_config), o_(o), daq_(daq), valve_(valve), faults_(faults), out_(out),
+        plant_(make_plant(config)), sensors_(transducers(config, daq_config)), rng_(config.seed) {
+    plant_->reset();
+    for (const auto& ch : daq_config.inputs) plant_of_input_.push_back(signal_index(*plant_, ch.name, "DAQ input"));
+    for (std::size_t i = 0; i < daq_config.outputs.size(); ++i) {
+      if (daq_config.outputs[i].name == plant_->commands().at(0).name) valve_daq_output_ = static_cast<int>(i);
+    }
+    if (valve_ == nullptr && valve_daq_output_ < 0) {
+      throw ConfigError(config.file + ": modbus.outputs: no output named '" + plant_->commands().at(0).name +
+                        "' drives the valve (or give --can-socket for a CANopen valve)");
+    }
+    truth_.resize(plant_->signals().size());
+    inputs_.resize(daq_config.inputs.size());
+    outputs_.resize(daq_config.outputs.size());
+    command_.assign(plant_->commands().size(), 0.0);
+  }
+
+  // Plant time t: the faults due, then the transducers' readings into the registers.
+  void measure(double t) {
+    faults_.apply(t);
+    plant_->measure(truth_);
+    for (std::size_t i = 0; i < inputs_.size(); ++i) {
+      inputs_[i] = sensors_[i].measure(truth_[static_cast<std::size_t>(plant_of_input_[i])], rng_);
+    }
+    daq_.set_inputs(inputs_.data(), inputs_.size());
+  }
+
+  // The command on the wire at plant time t, for the period from t on.
+  void take_command(double t) {
+    if (valve_ != nullptr) {
+      command_[0] = valve_->spool();
+    } else {
+      daq_.outputs(outputs_.data());
+      if (const int64_t w = daq_.writes(); w != last_writes_) {
+        last_writes_ = w;
+        last_write_t_ = t;
+        watchdog_tripped_ = false;
+      } else if (o_.output_watchdog_s > 0.0 && t - last_write_t_ > o_.output_watchdog_s) {
+        if (!watchdog_tripped_) {
+          out_ << "rig-sim: t = " << t << " s: output watchdog: no write for " << o_.output_watchdog_s
+               << " s, outputs at their safe values\n";
+          watchdog_tripped_ = true;
+        }
+        for (std::size_t i = 0; i < outputs_.size(); ++i) outputs_[i] = daq_config_.outputs[i].safe;
+      }
+      command_[0] = outputs_[static_cast<std::size_t>(valve_daq_output_)];
+    }
+    if (!std::isfinite(command_[0])) command_[0] = 0.0;
+    // Where the final stretch of null commands began: after a fault, the time
+    // the valve reached its safe value as the rig saw it (printed at the end).
+    if (command_[0] != 0.0) {
+      null_since_ = -1.0;
+    } else if (null_since_ < 0.0) {
+      null_since_ = t;
+    }
+  }
+
+  // Twice a second, what the rig does: lets a person (and the end-to-end
+  // tests) see that a fault left the valve at null.
+  void report(int64_t tick, double t) {
+    if (tick % std::max<int64_t>(1, std::llround(0.5 / config_.loop.period_s)) != 0) return;
+    out_ << "rig-sim: t = " << t << " s, valve " << plant_->commands()[0].name << " = " << command_[0];
+    for (std::size_t i = 0; i < inputs_.size() && i < 3; ++i) out_ << ", " << daq_config_.inputs[i].name << " = " << inputs_[i];
+    out_ << "\n";
+    out_.flush();
+  }
+
+  void advance() { plant_->advance(command_, config_.loop.period_s); }
+
+  // Lock-step: one exchange with the controller. The first answers the
+  // initial state; each later one steps the plant first with the command
+  // the controller sent before its request (the CANopen valve's, once the
+  // node has taken the frames already sent).
+  void exchange() {
+    if (exchanges_ > 0) {
+      if (valve_ != nullptr) valve_->take_pending_frames();
+      take_command(time(exchanges_ - 1));
+      advance();
+    }
+    const double t = time(exchanges_);
+    measure(t);
+    report(exchanges_, t);
+    plant_time_.store(t, std::memory_order_release);
+    ++exchanges_;
+  }
+
+  double time(int64_t tick) const { return static_cast<double>(tick) * config_.loop.period_s; }
+  double plant_time() const { return plant_time_.load(std::memory_order_acquire); }
+  const std::string& valve_name() const { return plant_->commands()[0].name; }
+  double null_since() const { return null_since_; }
+
+ private:
+  const RigConfig& config_;
+  const ModbusDaqConfig& daq_config_;
+  const RigSimOptions& o_;
+  SimModbusDaq& daq_;
+  SimCanopenValve* valve_;
+  FaultSchedule& faults_;
+  std::ostream& out_;
+  std::unique_ptr<SimulatedPlant> plant_;
+  std::vector<SensorModel> sensors_;
+  std::mt19937_64 rng_;
+  std::vector<int> plant_of_input_;
+  int valve_daq_output_ = -1;
+  std::vector<double> truth_, inputs_, outputs_, command_;
+  double null_since_ = -1.0;
+  int64_t last_writes_ = 0;
+  double last_write_t_ = 0.0;
+  bool watchdog_tripped_ = false;
+  int64_t exchanges_ = 0;
+  std::atomic<double> plant_time_{0.0};
+};
+
+// Free-running: one period per period of the monotonic clock.
+void run_paced(RigSimPlant& plant, const RigConfig& config, const RigSimOptions& o, const std::atomic<bool>& stop) {
+  MonotonicClock clock;
+  const auto period_ns = static_cast<int64_t>(config.loop.period_s * 1e9 + 0.5);
+  int64_t deadline = clock.now_ns();
+  for (int64_t tick = 0;; ++tick) {
+    const double t = plant.time(tick);
+    if (stop.load() || (o.duration_s && t >= *o.duration_s)) break;
+    plant.measure(t);
+    plant.take_command(t);
+    plant.report(tick, t);
+    plant.advance();
+    deadline += period_ns;
+    clock.sleep_until(deadline);
+  }
+}
+
+// Lock-step: the DAQ's server thread steps the plant; this one waits for the
+// end (a signal, or --duration of plant time).
+void run_lock_step(RigSimPlant& plant, const RigSimOptions& o, const std::atomic<bool>& stop) {
+  while (!stop.load() && !(o.duration_s && plant.plant_time() >= *o.duration_s)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));  // only how soon a stop is seen
+  }
+}
+
 }  // namespace
 
 void run_rig_sim(const RigSimOptions& o, const std::atomic<bool>& stop, std::ostream& out) {
@@ -182,8 +331,6 @@ void run_rig_sim(const RigSimOptions& o, const std::atomic<bool>& stop, std::ost
   ModbusDaqConfig daq_config = *config.modbus;
   daq_config.connection = far_side_connection(o, daq_config.connection);
   SimModbusDaq daq(daq_config);
-  daq.start();
-  out << "rig-sim: modbus listening on " << daq.endpoint() << "\n";
 
   std::unique_ptr<SimCanopenValve> valve;
   if (with_valve) {
@@ -195,88 +342,23 @@ void run_rig_sim(const RigSimOptions& o, const std::atomic<bool>& stop, std::ost
     vc.spool_time_constant_s = 0.0;
     for (const auto& option : o.valve_options) apply_sim_valve_option(option, vc);
     valve = std::make_unique<SimCanopenValve>(o.can_socket, vc);
-    out << "rig-sim: canopen valve on " << o.can_socket << "\n";
   }
+  FaultSchedule faults(o.faults, daq, valve.get(), out);
+  RigSimPlant plant(config, daq_config, o, daq, valve.get(), faults, out);
+  if (o.lock_step) daq.set_exchange_hook([&plant] { plant.exchange(); });
+  daq.start();
+  out << "rig-sim: modbus listening on " << daq.endpoint() << (o.lock_step ? " (lock-step)" : "") << "\n";
+  if (valve) out << "rig-sim: canopen valve on " << o.can_socket << "\n";
   out.flush();
 
-  auto plant = make_plant(config);
-  plant->reset();
-  const auto& signals = plant->signals();
-  std::vector<int> plant_of_input;
-  for (const auto& ch : daq_config.inputs) plant_of_input.push_back(signal_index(*plant, ch.name, "DAQ input"));
-  int valve_daq_output = -1;
-  for (std::size_t i = 0; i < daq_config.outputs.size(); ++i) {
-    if (daq_config.outputs[i].name == plant->commands().at(0).name) valve_daq_output = static_cast<int>(i);
+  if (o.lock_step) {
+    run_lock_step(plant, o, stop);
+  } else {
+    run_paced(plant, config, o, stop);
   }
-  if (!with_valve && valve_daq_output < 0) {
-    throw ConfigError(config.file + ": modbus.outputs: no output named '" + plant->commands().at(0).name +
-                      "' drives the valve (or give --can-socket for a CANopen valve)");
-  }
-
-  FaultSchedule faults(o.faults, daq, valve.get(), out);
-  auto sensors = transducers(config, daq_config);
-  std::mt19937_64 rng(config.seed);
-  std::vector<double> truth(signals.size()), inputs(daq_config.inputs.size()), outputs(daq_config.outputs.size());
-  std::vector<double> command(plant->commands().size(), 0.0);
-
-  MonotonicClock clock;
-  const auto period_ns = static_cast<int64_t>(config.loop.period_s * 1e9 + 0.5);
-  const int64_t t0 = clock.now_ns();
-  int64_t deadline = t0;
-  double null_since = -1.0;
-  int64_t last_writes = 0;
-  double last_write_t = 0.0;
-  bool watchdog_tripped = false;
-  for (int64_t tick = 0;; ++tick) {
-    const double t = static_cast<double>(tick) * config.loop.period_s;
-    if (stop.load() || (o.duration_s && t >= *o.duration_s)) break;
-    faults.apply(t);
-    plant->measure(truth);
-    for (std::size_t i = 0; i < inputs.size(); ++i) {
-      inputs[i] = sensors[i].measure(truth[static_cast<std::size_t>(plant_of_input[i])], rng);
-    }
-    daq.set_inputs(inputs.data(), inputs.size());
-    if (with_valve) {
-      command[0] = valve->spool();
-    } else {
-      daq.outputs(outputs.data());
-      if (const int64_t w = daq.writes(); w != last_writes) {
-        last_writes = w;
-        last_write_t = t;
-        watchdog_tripped = false;
-      } else if (o.output_watchdog_s > 0.0 && t - last_write_t > o.output_watchdog_s) {
-        if (!watchdog_tripped) {
-          out << "rig-sim: t = " << t << " s: output watchdog: no write for " << o.output_watchdog_s
-              << " s, outputs at their safe values\n";
-          watchdog_tripped = true;
-        }
-        for (std::size_t i = 0; i < outputs.size(); ++i) outputs[i] = daq_config.outputs[i].safe;
-      }
-      command[0] = outputs[static_cast<std::size_t>(valve_daq_output)];
-    }
-    if (!std::isfinite(command[0])) command[0] = 0.0;
-    // Where the final stretch of null commands began: after a fault, the time
-    // the valve reached its safe value as the rig saw it (printed at the end).
-    if (command[0] != 0.0) {
-      null_since = -1.0;
-    } else if (null_since < 0.0) {
-      null_since = t;
-    }
-    // Twice a second, what the rig does: lets a person (and the end-to-end
-    // tests) see that a fault left the valve at null.
-    if (tick % std::max<int64_t>(1, std::llround(0.5 / config.loop.period_s)) == 0) {
-      out << "rig-sim: t = " << t << " s, valve " << plant->commands()[0].name << " = " << command[0];
-      for (std::size_t i = 0; i < inputs.size() && i < 3; ++i) out << ", " << daq_config.inputs[i].name << " = " << inputs[i];
-      out << "\n";
-      out.flush();
-    }
-    plant->advance(command, config.loop.period_s);
-    deadline += period_ns;
-    clock.sleep_until(deadline);
-  }
+  daq.stop();  // first: in lock-step its thread steps the plant, which reads the valve
   if (valve) valve.reset();
-  daq.stop();
-  if (null_since >= 0.0) out << "rig-sim: valve " << plant->commands()[0].name << " = 0 since t = " << null_since << " s\n";
+  if (plant.null_since() >= 0.0) out << "rig-sim: valve " << plant.valve_name() << " = 0 since t = " << plant.null_since() << " s\n";
   out << "rig-sim: stopped\n";
 }
 
