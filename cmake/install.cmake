@@ -23,7 +23,7 @@ install(CODE [[
   endif()
   file(INSTALL "${RIGCTL_SOURCE_DIR}/config/quarter_car.yaml" "${RIGCTL_SOURCE_DIR}/config/pneumatic_rotary.yaml"
                "${RIGCTL_SOURCE_DIR}/config/half_car.yaml"
-       DESTINATION "$ENV{DESTDIR}${RIGCTL_SYSCONFDIR}/rigctl")
+       DESTINATION "${RIGCTL_SYSCONFDIR}/rigctl")  # file(INSTALL) adds DESTDIR itself
   configure_file("${RIGCTL_SOURCE_DIR}/systemd/rigctl.service.in"
                  "$ENV{DESTDIR}${RIGCTL_PREFIX}/lib/systemd/system/rigctl.service" @ONLY)
   message(STATUS "Installing: $ENV{DESTDIR}${RIGCTL_PREFIX}/lib/systemd/system/rigctl.service")

@@ -15,7 +15,7 @@ if(GIT_FOUND)
     execute_process(COMMAND "${GIT_EXECUTABLE}" rev-parse --symbolic-full-name HEAD
                     WORKING_DIRECTORY "${PROJECT_SOURCE_DIR}" OUTPUT_VARIABLE _branch
                     OUTPUT_STRIP_TRAILING_WHITESPACE ERROR_QUIET)
-    foreach(_name HEAD ${_branch})
+    foreach(_name HEAD ${_branch} packed-refs)
       execute_process(COMMAND "${GIT_EXECUTABLE}" rev-parse --path-format=absolute --git-path "${_name}"
                       WORKING_DIRECTORY "${PROJECT_SOURCE_DIR}" OUTPUT_VARIABLE _path
                       OUTPUT_STRIP_TRAILING_WHITESPACE ERROR_QUIET)
