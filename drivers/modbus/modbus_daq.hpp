@@ -114,7 +114,8 @@ class ModbusDaq {
   // age of the oldest input in ns (INT64_MAX while one was never read).
   // Requires first_index + input_count() <= kMaxInputs (else nothing is touched).
   // In lock-step (ModbusDaqConfig::lock_step) every call after the first
-  // first runs one I/O cycle and waits for it (it locks and waits then).
+  // runs one I/O cycle and waits for it (it locks and waits then), and an
+  // input is stale when that cycle did not read it (no wall-clock age).
   int64_t read_inputs(Sample& out, std::size_t first_index, int64_t now_ns) noexcept;
 
   // Posts the outputs (SI, output order; n <= output_count(), missing ones
@@ -181,7 +182,8 @@ class ModbusDaq {
   std::condition_variable step_cv_;
   int64_t cycles_requested_ = 0;
   int64_t cycles_done_ = 0;
-  int64_t lock_step_reads_ = 0;  // loop thread only
+  int64_t lock_step_reads_ = 0;      // loop thread only
+  int64_t lock_step_since_ns_ = 0;   // when the loop asked for the present cycle (0: start()'s)
 
   // Loop-side counters (relaxed atomics: the loop must not lock).
   std::atomic<int64_t> stale_samples_{0};
