@@ -30,7 +30,7 @@ echo "package_check: built $(basename "$deb") ($(du -k "$deb" | cut -f1) kB)"
 fail() { echo "package_check: $*" >&2; exit 1; }
 depends=$(dpkg-deb -f "$deb" Depends)
 echo "package_check: Depends: $depends"
-for lib in libc6 libstdc++6 liblcm1 libmodbus5 libceres3 libsystemd0; do
+for lib in libc6 libstdc++6 liblcm1 libmodbus5 libsystemd0; do  # not libceres3: Debian's CeresTargets names libceres.a
   [[ $depends == *"$lib"* ]] || fail "Depends does not name $lib (is CPACK_DEBIAN_PACKAGE_SHLIBDEPS on?)"
 done
 [[ $depends != *-dev* ]] || fail "Depends names a -dev package: $depends"
