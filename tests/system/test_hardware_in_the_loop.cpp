@@ -111,7 +111,7 @@ class HardwareInTheLoop : public RigSimTest {
 // valve command goes through the holding register or the CiA 408 setpoint
 // instead of the DAC model, and the two computations differ in the last
 // bits. With the body's stick-slip such a difference now and then moves a
-// reading to the next count (about 1 % of the samples measured here). Both
+// reading to the next count (1-2 % of the samples measured here). Both
 // runs are deterministic: the same counts on every run, however busy the
 // machine, so the bounds are what was measured (2026-11-27, printed by the
 // tests): every position within one count of the in-process run, and the
@@ -141,10 +141,11 @@ TEST_F(HardwareInTheLoop, StepTestOverModbusInLockStepMatchesTheInProcessSimulat
 // With the CANopen valve the command travels as the CiA 408 spool setpoint,
 // an int16 with 16384 counts for 100 % (one count 6.1e-5, twice the
 // in-process DAC's LSB). Measured: max one count on every position, rms at
-// most 0.22 counts (x_b); u max 5.01e-4. Bounds: two counts (the valve's
-// null keepalive, sent by the driver's own thread while the loop holds the
-// valve safe, can reach the valve just after the first driven setpoint and
-// delay it by a tick), and kp times a count plus one setpoint count for u.
+// most 0.22 counts (x_b); u max 5.01e-4. Bounds: two counts (one of margin:
+// the driver's own thread sends null setpoints while the loop holds the
+// valve safe, and one sent just before the loop's first driven setpoint
+// could reach the valve after it), and kp times a count plus one setpoint
+// count for u.
 TEST_F(HardwareInTheLoop, StepTestWithTheCanopenValveInLockStepMatchesTheInProcessSimulationToACount) {
   const int port = start_rig_sim_with_valve({"--lock-step"});
   ASSERT_GT(port, 0);
