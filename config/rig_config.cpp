@@ -1,4 +1,5 @@
 #include "config/rig_config.hpp"
+#include "config/suspension_controller_reader.hpp"
 
 #include <arpa/inet.h>
 

@@ -16,7 +16,7 @@
 #include "config/operator_config.hpp"
 #include "config/profile_kind.hpp"
 #include "config/rig_kind.hpp"
-#include "config/suspension_controller_reader.hpp"
+#include "config/suspension_settings.hpp"
 #include "drivers/canopen/canopen_valve_config.hpp"
 #include "drivers/modbus/modbus_daq_config.hpp"
 #include "drivers/sim/sensor_model.hpp"

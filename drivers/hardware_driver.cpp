@@ -52,6 +52,7 @@ void HardwareDriver::start() {
   // Rig time starts with the loop, not with the devices' start-up (the
   // valve's SDO configuration takes a good part of a second).
   start_ns_ = ModbusDaq::now_ns();
+  lock_step_reads_ = 0;
 }
 
 bool HardwareDriver::read(Sample& out) {
@@ -65,7 +66,10 @@ bool HardwareDriver::read(Sample& out) {
     // the setpoint (it left DEVICE MODE ACTIVE, or is not heard from).
     if ((out.status >> daq_inputs_) & 1U) out.outputs_not_following |= 1U << valve_output_;
   }
-  out.t_ns = now - start_ns_;
+  // Lock-step (rig-sim --lock-step): the far side's plant time is the count
+  // of reads, one poll period each; otherwise the monotonic clock's.
+  const ModbusDaqConfig& daq = daq_->config();
+  out.t_ns = daq.lock_step ? lock_step_reads_++ * static_cast<int64_t>(daq.poll_period_s * 1e9 + 0.5) : now - start_ns_;
   // Commands the DAQ could not deliver leave the valve on an old command:
   // as dangerous as stale inputs, so the loop faults.
   return daq_outputs_ == 0 || daq_->output_age_ns(now) <= max_output_age_ns_;

@@ -41,6 +41,7 @@ class HardwareDriver final : public Driver {
   std::size_t valve_output_ = 0;  // index of the valve setpoint among the outputs
   int64_t start_ns_ = 0;
   int64_t max_output_age_ns_ = 0;
+  int64_t lock_step_reads_ = 0;  // reads since start(), in lock-step
 };
 
 }  // namespace rigctl

@@ -27,6 +27,7 @@
 #include "tools/rig_sim/rig_sim.hpp"
 #include "tools/run/run_command.hpp"
 #include "tools/suspension/compare_command.hpp"
+#include "generated/rigctl_version.hpp"  // cmake/version.cmake: version and git revision
 
 namespace {
 
@@ -57,7 +58,7 @@ std::vector<std::pair<std::string, double>> parse_effects(const std::vector<std:
 int main(int argc, char** argv) {
   CLI::App app{"rigctl: real-time controller and simulator for servo-hydraulic and pneumatic test rigs"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "rigctl 0.1.0");
+  app.set_version_flag("--version", RIGCTL_VERSION_TEXT);
 
   rigctl::RunOptions run;
   double duration = 0.0;
@@ -66,6 +67,7 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--case", run.case_name, "Apply a named variant from the config's `cases:` (e.g. fig4c)");
   auto* duration_opt = run_cmd->add_option("--duration", duration, "Run length [s] (default: the profile's length)")->check(CLI::PositiveNumber);
   run_cmd->add_flag("--fast", run.fast, "Simulated plant only: run as fast as the CPU allows, same results as paced");
+  run_cmd->add_flag("--lock-step", run.lock_step, "Tests: Modbus driver against `rig-sim --lock-step`, one DAQ exchange per tick, simulated time");
   run_cmd->add_option("--log", run.log_path, "LCM log file to write (default: a new file in the config's log_dir)");
   run_cmd->add_option("--csv", run.csv_path, "Also write the run as a CSV run file");
   run_cmd->add_option("--events", run.events_path, "Event log to append to (default: <log>.events; SAFETY.md)");
@@ -131,6 +133,7 @@ int main(int argc, char** argv) {
                       "stall=init|disabled|hold; repeatable");
   auto* sim_duration_opt = sim_cmd->add_option("--duration", sim_duration, "Stop after this many seconds (default: at SIGINT/SIGTERM)")->check(CLI::PositiveNumber);
   sim_cmd->add_option("--output-watchdog", sim.output_watchdog_s, "DAQ output watchdog [s]: no write for this long and the outputs go to their safe values; 0: off")->capture_default_str();
+  sim_cmd->add_flag("--lock-step", sim.lock_step, "Tests: step the plant one loop period per DAQ exchange (`run --lock-step`), not by the clock");
   sim_cmd->add_option("--fault", fault_texts, "Inject a fault, KIND@TIME[:ARG...] (silence, drop, late, exception, stuck, rail, heartbeat, emcy, hold); repeatable");
 
   rigctl::CompareOptions compare;

@@ -1,8 +1,12 @@
 #!/usr/bin/env bash
 # README command 2: set up, build and run the whole test suite.
-#   tools/test.sh            setup + build, ctest once, then the fuzzing step
-#   tools/test.sh --soak N   setup + build, then the suite N times with a CPU
-#                            hog on every core; failures per test at the end
+#   tools/test.sh            setup + build, ctest once, the Debian package built,
+#                            installed and run (tools/scripts/package_check.sh),
+#                            then the fuzzing step
+#   tools/test.sh --soak N   setup + build, then the suite N times beside a
+#                            load (stress-ng: two CPU hogs per core and a disk
+#                            writer; RIGCTL_SOAK_HOG="stress-ng options" for
+#                            another); failures per test at the end
 # Either way a test that leaves a file in the source tree fails the run: tests
 # write only into their own temporary directories.
 set -euo pipefail
@@ -38,6 +42,7 @@ if [ "$soak" -eq 0 ]; then
   failed=()
   ctest --output-on-failure -j"$jobs" --timeout 900 || failed+=(ctest)
   check_tree || failed+=("source tree check")
+  "$root/tools/scripts/package_check.sh" "$root/build" || failed+=(package)  # the .deb installed and run outside the source tree
   "$root/tools/scripts/fuzz.sh" 10 || failed+=(fuzzing)  # libFuzzer harnesses (tests/fuzz/README.md): corpus replay plus 10 s per target
   if [ ${#failed[@]} -gt 0 ]; then
     echo "test.sh: failed: ${failed[*]}" >&2
@@ -46,19 +51,24 @@ if [ "$soak" -eq 0 ]; then
   exit 0
 fi
 
-# Soak: the suite under a CPU hog at normal priority on every core (Debian's
-# stress-ng), as on a busy CI machine with a build beside the tests.
+# Soak: the suite beside a load at normal priority (Debian's stress-ng), as on
+# a busy CI machine with builds beside the tests: by default two CPU hogs per
+# core (a runnable thread waits behind two others, not one) and a disk writer
+# (fsyncs and page cache pressure, which the event log's and run log's
+# writers feel).
 "$root/tools/scripts/install_packages.sh" soak stress-ng
+read -r -a hog_options <<< "${RIGCTL_SOAK_HOG:---cpu $((2 * jobs)) --cpu-method matrixprod --hdd 1}"
 hog_pid=""
 stop_hog() { if [ -n "$hog_pid" ]; then kill "$hog_pid" 2>/dev/null || true; wait "$hog_pid" 2>/dev/null || true; hog_pid=""; fi; }
 trap stop_hog EXIT
 declare -A failures=()
 failed_runs=0
 for ((run = 1; run <= soak; run++)); do
-  stress-ng --cpu "$jobs" --cpu-method matrixprod --timeout 0 --quiet &
+  # --temp-path: the disk writer's files in the build folder, not the source tree.
+  stress-ng "${hog_options[@]}" --temp-path "$root/build" --timeout 0 --quiet &
   hog_pid=$!
   start=$(date +%s)
-  echo "soak run $run/$soak: ctest -j$jobs beside stress-ng --cpu $jobs (pid $hog_pid)"
+  echo "soak run $run/$soak: ctest -j$jobs beside stress-ng ${hog_options[*]} (pid $hog_pid)"
   status=0
   ctest --output-on-failure -j"$jobs" --timeout 900 > "soak-$run.log" 2>&1 || status=$?
   stop_hog

@@ -72,6 +72,7 @@ void ModbusDaq::start(double first_sample_timeout_s) {
   make_safe();  // no stale command from a previous run; the loop is not running yet
   io_->forget_inputs(never_read());
   outputs_written_ns_ = 0;
+  cycles_requested_ = cycles_done_ = lock_step_reads_ = lock_step_since_ns_ = 0;
   thread_ = std::thread([this] { io_->run(); });
   if (config_.io_priority > 0) {
     // Set from here, so a refusal (not root, no rtprio limit) is reported
@@ -98,13 +99,45 @@ void ModbusDaq::start(double first_sample_timeout_s) {
 
 void ModbusDaq::stop() {
   if (!thread_.joinable()) return;
-  stop_requested_ = true;
+  {
+    std::lock_guard lock(step_mutex_);
+    stop_requested_ = true;
+  }
+  step_cv_.notify_all();
   thread_.join();
+}
+
+void ModbusDaq::run_one_cycle() noexcept {
+  std::unique_lock lock(step_mutex_);
+  const int64_t wanted = ++cycles_requested_;
+  step_cv_.notify_all();
+  step_cv_.wait(lock, [&] { return cycles_done_ >= wanted || stop_requested_.load(); });
+}
+
+bool ModbusDaq::wait_for_cycle_request() noexcept {
+  std::unique_lock lock(step_mutex_);
+  step_cv_.wait(lock, [&] { return cycles_requested_ > cycles_done_ || stop_requested_.load(); });
+  return !stop_requested_.load();
+}
+
+void ModbusDaq::cycle_done() noexcept {
+  {
+    std::lock_guard lock(step_mutex_);
+    cycles_done_ = cycles_requested_;
+  }
+  step_cv_.notify_all();
 }
 
 int64_t ModbusDaq::read_inputs(Sample& out, std::size_t first_index, int64_t now) noexcept {
   const std::size_t n = config_.inputs.size();
   if (first_index + n > kMaxInputs) return std::numeric_limits<int64_t>::max();
+  // Lock-step: the first read takes start()'s sample, each later one a cycle
+  // of its own; an input is fresh when that cycle read it, however long the
+  // machine took (the far side's plant waited too).
+  if (config_.lock_step && lock_step_reads_++ > 0) {
+    lock_step_since_ns_ = now_ns();
+    run_one_cycle();
+  }
   const InputSnapshot& s = inputs_.read();
   const int64_t max_age = to_ns(config_.max_sample_age_s);
   int64_t oldest = 0;
@@ -114,7 +147,8 @@ int64_t ModbusDaq::read_inputs(Sample& out, std::size_t first_index, int64_t now
     const int64_t t = s.acquired_ns[i];
     const int64_t age = t == 0 ? std::numeric_limits<int64_t>::max() : now - t;
     oldest = std::max(oldest, age);
-    const bool bad = age > max_age || !std::isfinite(s.value[i]);
+    const bool old = config_.lock_step ? t == 0 || t < lock_step_since_ns_ : age > max_age;
+    const bool bad = old || !std::isfinite(s.value[i]);
     out.value[k] = s.value[i];
     const uint32_t bit = 1u << k;
     out.status = bad ? (out.status | bit) : (out.status & ~bit);
@@ -146,7 +180,11 @@ void ModbusDaq::make_safe() noexcept {
 int64_t ModbusDaq::output_age_ns(int64_t now) const noexcept {
   if (config_.outputs.empty()) return 0;
   const int64_t t = outputs_written_ns_.load(std::memory_order_acquire);
-  return t == 0 ? std::numeric_limits<int64_t>::max() : now - t;
+  if (t == 0) return std::numeric_limits<int64_t>::max();
+  // Lock-step: written by the cycle this tick asked for (or, on the first
+  // tick, by start()'s), whatever the clock says.
+  if (config_.lock_step) return t >= lock_step_since_ns_ ? 0 : std::numeric_limits<int64_t>::max();
+  return now - t;
 }
 
 void ModbusDaq::add_event(std::string text) {

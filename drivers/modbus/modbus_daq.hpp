@@ -113,6 +113,9 @@ class ModbusDaq {
   // clears it otherwise. now_ns is CLOCK_MONOTONIC (now_ns()). Returns the
   // age of the oldest input in ns (INT64_MAX while one was never read).
   // Requires first_index + input_count() <= kMaxInputs (else nothing is touched).
+  // In lock-step (ModbusDaqConfig::lock_step) every call after the first
+  // runs one I/O cycle and waits for it (it locks and waits then), and an
+  // input is stale when that cycle did not read it (no wall-clock age).
   int64_t read_inputs(Sample& out, std::size_t first_index, int64_t now_ns) noexcept;
 
   // Posts the outputs (SI, output order; n <= output_count(), missing ones
@@ -152,6 +155,11 @@ class ModbusDaq {
   static OutputCommand safe_command(const ModbusDaqConfig& config);
   static InputSnapshot never_read();
 
+  // Lock-step: the loop's side asks for one cycle and waits for its end; the
+  // I/O thread waits for a request (false: stop requested) and reports its end.
+  void run_one_cycle() noexcept;
+  bool wait_for_cycle_request() noexcept;
+  void cycle_done() noexcept;
   void add_event(std::string text);  // with mutex_ held
 
   ModbusDaqConfig config_;
@@ -167,6 +175,14 @@ class ModbusDaq {
   std::atomic<bool> first_sample_{false};
   std::atomic<bool> connected_{false};
   std::atomic<int64_t> outputs_written_ns_{0};  // end of the last complete successful write; 0: never
+
+  // Lock-step cycles asked for by the loop and completed by the I/O thread.
+  std::mutex step_mutex_;
+  std::condition_variable step_cv_;
+  int64_t cycles_requested_ = 0;
+  int64_t cycles_done_ = 0;
+  int64_t lock_step_reads_ = 0;      // loop thread only
+  int64_t lock_step_since_ns_ = 0;   // when the loop asked for the present cycle (0: start()'s)
 
   // Loop-side counters (relaxed atomics: the loop must not lock).
   std::atomic<int64_t> stale_samples_{0};

@@ -58,6 +58,14 @@ struct ModbusDaqConfig {
   // loaded machine a normal-priority I/O thread misses its period and the
   // inputs go stale. Just below the loop's priority is the natural choice.
   int io_priority = 0;
+  // Lock-step (tests against `rigctl rig-sim --lock-step`, in simulated
+  // time; never on a rig): after the first sample the I/O thread has no clock
+  // of its own. Each read_inputs() after the first runs one whole cycle,
+  // outputs first, then inputs, and waits for it, so the far side's plant
+  // steps once per loop tick with the command of the tick before, as the
+  // simulated driver's does. The loop then waits on the wire: fine in
+  // simulated time, not in a paced run.
+  bool lock_step = false;
 };
 
 // Throws std::invalid_argument naming the first problem: counts, ranges,

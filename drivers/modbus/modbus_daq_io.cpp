@@ -59,9 +59,16 @@ ModbusDaq::Io::Io(ModbusDaq& daq)
 void ModbusDaq::Io::run() noexcept {
   int64_t next = now_ns();
   while (!daq_.stop_requested_.load()) {
+    // Lock-step: once the first sample is in, a cycle only when the loop asks.
+    const bool requested = config_.lock_step && daq_.first_sample_.load();
+    if (requested && !daq_.wait_for_cycle_request()) break;
     if (!link_.is_open() && now_ns() >= next_connect_ns_) connect();
     const bool ran = link_.is_open();
     if (ran) cycle();
+    if (requested) {
+      daq_.cycle_done();
+      continue;
+    }
     next = next_deadline(next, ran);
     sleep_until(next);
   }
@@ -186,10 +193,14 @@ bool ModbusDaq::Io::recover_after_failure(const ModbusResult& r) {
 
 void ModbusDaq::Io::cycle() {
   const int64_t t0 = now_ns();
+  // Lock-step: the previous tick's command goes out before the inputs are
+  // read, so the far side steps its plant with it before it answers.
+  const bool outputs_first = config_.lock_step && daq_.first_sample_.load();
+  if (outputs_first && !write_blocks(daq_.outputs_.read())) return;
   const ReadOutcome read = read_blocks();
   publish_inputs(read.go_on);
   if (!read.go_on) return;
-  const bool wrote = write_blocks(daq_.outputs_.read());
+  const bool wrote = outputs_first || write_blocks(daq_.outputs_.read());
   if (!(wrote && read.all_ok)) return;
   const int64_t took = now_ns() - t0;
   std::lock_guard lock(daq_.mutex_);

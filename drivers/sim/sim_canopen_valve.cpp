@@ -59,6 +59,8 @@ SimCanopenValve::SimCanopenValve(CanTransport transport, SimCanopenValveConfig c
 SimCanopenValve::~SimCanopenValve() {
   stop_.store(true, std::memory_order_release);
   if (thread_.joinable()) thread_.join();
+  { std::lock_guard<std::mutex> lock(mutex_); }
+  pass_done_.notify_all();  // a take_pending_frames() waiting now returns
 }
 
 OdEntry& SimCanopenValve::od(uint16_t index, uint8_t subindex) {
@@ -91,7 +93,17 @@ void SimCanopenValve::run() {
     }
     step(now);
     flush(now);
+    ++passes_;
+    pass_done_.notify_all();
   }
+}
+
+void SimCanopenValve::take_pending_frames() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  // A pass already under way may have looked at the socket before the
+  // frames came; the one after it starts later and takes them.
+  const uint64_t wanted = passes_ + 2;
+  pass_done_.wait(lock, [&] { return passes_ >= wanted || stop_.load(std::memory_order_acquire); });
 }
 
 // Waits for frames until something is due, handles what is queued, steps once.
@@ -118,6 +130,8 @@ void SimCanopenValve::serve_frames() {
   if (rx == CanTransport::Rx::kHangUp || rx == CanTransport::Rx::kError) drop_requested_ = true;
   step(now);
   flush(now);
+  ++passes_;
+  pass_done_.notify_all();
   if (drop_requested_) {
     drop_requested_ = false;
     transport_.shutdown();

@@ -43,6 +43,7 @@
 #pragma once
 
 #include <atomic>
+#include <condition_variable>
 #include <cstdint>
 #include <deque>
 #include <memory>
@@ -75,6 +76,11 @@ class SimCanopenValve {
 
   // The valve opening the plant uses: spool position, fraction of rated, -1..1.
   double spool() const noexcept { return spool_.load(std::memory_order_acquire); }
+  // Returns once the node has taken every frame that was in its socket when
+  // called (two whole passes of its thread later): `rig-sim --lock-step`
+  // steps the plant with the setpoint the controller sent before its DAQ
+  // request. Returns at once when the node is stopping.
+  void take_pending_frames();
   // Pressure reported in the TPDO (when mapped), Pa.
   void set_pressure(double pa) noexcept { pressure_.store(pa, std::memory_order_release); }
 
@@ -183,6 +189,8 @@ class SimCanopenValve {
   bool drop_requested_ = false;
   int sdo_answers_to_lose_ = 0;
   Stats stats_;
+  uint64_t passes_ = 0;                // the node thread's passes (receive, handle, step)
+  std::condition_variable pass_done_;  // with mutex_, after each pass
 
   std::atomic<double> spool_{0.0};
   std::atomic<double> pressure_{0.0};

@@ -271,6 +271,14 @@ void SimModbusDaq::handle(const uint8_t* req, int length) noexcept {
     default:
       break;  // FC 6 writes one holding register; others are left to modbus_reply
   }
+  if (exchange_hook_ && type == RegisterType::kInputRegister && function == MODBUS_FC_READ_INPUT_REGISTERS &&
+      !config_.inputs.empty()) {
+    const ModbusPoint& first = config_.inputs.front().point;
+    if (first.type == RegisterType::kInputRegister && unit == first.unit_id && address <= first.address &&
+        first.address < address + count) {
+      exchange_hook_();
+    }
+  }
 
   std::lock_guard lock(mutex_);
   for (const auto& f : exceptions_) {

@@ -15,6 +15,7 @@
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <string>
@@ -52,6 +53,12 @@ class SimModbusDaq {
   // the endpoint.
   void start();
   void stop();  // idempotent
+
+  // Called on the server thread for every request that reads the first
+  // input's registers, before it is answered (the hook may call
+  // set_inputs): `rigctl rig-sim --lock-step` steps its plant there. Set it
+  // before start().
+  void set_exchange_hook(std::function<void()> hook) { exchange_hook_ = std::move(hook); }
 
   int port() const noexcept { return port_; }            // TCP: the bound port, after start()
   const std::string& endpoint() const noexcept { return endpoint_; }
@@ -110,6 +117,7 @@ class SimModbusDaq {
   int listen_fd_ = -1;
   int wake_fds_[2] = {-1, -1};
   std::vector<int> clients_;  // server thread only
+  std::function<void()> exchange_hook_;
   std::thread thread_;
   std::atomic<bool> stop_requested_{false};
 

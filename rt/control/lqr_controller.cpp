@@ -1,4 +1,5 @@
 #include "rt/control/lqr_controller.hpp"
+#include "rt/control/lqr_design.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>

@@ -15,9 +15,12 @@
 //               + sum_i (z_ui/t)^2 + (z_s/h)^2 + (phi/p)^2 + sum_i (F_i/F)^2 dt
 // The accelerations depend on the forces directly, which gives the cross
 // term N and adds to R.
+//
+// The design itself (Eigen) is in rt/control/lqr_design.hpp: this header is
+// read wherever a rig's config is (config/rig_config.hpp), and Eigen's Dense
+// module would cost every one of those translation units its parse.
 #pragma once
 
-#include <Eigen/Dense>
 #include <array>
 
 #include "plant/half_car/half_car_params.hpp"
@@ -34,17 +37,6 @@ struct LqrWeights {
   double angle = 0.03;               // p [rad]
   double force = 2000.0;             // F [N]: the actuator limit
 };
-
-struct LqrDesign {
-  Eigen::Matrix<double, 2, 8> K = Eigen::Matrix<double, 2, 8>::Zero();
-  double residual = 0.0;              // relative Riccati residual
-  double max_closed_loop_real = 0.0;  // [1/s]
-  Eigen::Matrix<double, 8, 1> closed_loop_damping = Eigen::Matrix<double, 8, 1>::Zero();  // per eigenvalue
-};
-
-// Designs K for the model of `params` (states scaled to typical magnitudes
-// and forces to the force weight before solving, for conditioning).
-LqrDesign design_half_car_lqr(const HalfCarParams& params, const LqrWeights& weights);
 
 struct LqrConfig {
   std::array<std::array<double, 8>, 2> gain{};  // K, rows f_1, f_2

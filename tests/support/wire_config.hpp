@@ -51,4 +51,26 @@ inline std::string wire_config(const std::string& driver, int port, const std::s
   return text;
 }
 
+// The same for `rigctl run --lock-step` against `rig-sim --lock-step`: the
+// loop runs in simulated time at normal priority and waits on the wire each
+// tick, so a loaded machine can hold it (and the valve's view of it) for
+// longer than a paced loop at SCHED_FIFO; the wall-clock deadlines that
+// remain (the valve's spool actual value and heartbeats, its setpoint
+// deadline) get seconds. They are not what the lock-step tests measure: the
+// fault tests run paced with the config above. (The DAQ's inputs cannot go
+// stale in lock-step: each read waits for a fresh one.) The DAQ's response
+// timeout too: a reply given up on would leave rig-sim's plant one step
+// ahead of the loop's count.
+inline std::string lock_step_wire_config(const std::string& driver, int port, const std::string& valve_socket) {
+  constexpr double kDeadline = 5.0;  // [s] far beyond any stall seen here (184 ms)
+  const std::string age = std::to_string(kWireMaxAge), deadline = std::to_string(kDeadline);
+  std::string text = wire_config(driver, port, valve_socket);
+  text = edit(text, "response_timeout_s: 0\\.01", "response_timeout_s: " + deadline);
+  text = edit(text, "actual_max_age_s: " + age, "actual_max_age_s: " + deadline);
+  text = edit(text, "heartbeat_timeout_s: " + age, "heartbeat_timeout_s: " + deadline);
+  text = edit(text, "valve_consumer_time_s: 1\\.0", "valve_consumer_time_s: " + deadline);
+  text = edit(text, "setpoint_timeout_s: " + age, "setpoint_timeout_s: " + deadline);
+  return text;
+}
+
 }  // namespace rigctl::test

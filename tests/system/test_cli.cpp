@@ -53,6 +53,25 @@ TEST_F(CliTest, HelpListsTheSubcommands) {
   EXPECT_NE(run_command(kRigctl).exit_code, 0) << "a subcommand is required";
 }
 
+// `rigctl --version`: the project's version and the git revision the build
+// was configured from (cmake/version.cmake), which is the checkout's own
+// `git describe` (configuring again follows each commit; "-dirty" is the
+// state at configure time, so it is not compared).
+TEST_F(CliTest, VersionNamesTheVersionAndTheGitRevision) {
+  const auto r = run_command(kRigctl + " --version");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(r.output, m, std::regex(R"(^rigctl ([0-9]+\.[0-9]+\.[0-9]+) \(git ([^)\s]+)\)\n?$)")))
+      << r.output;
+  const std::string revision = std::regex_replace(m[2].str(), std::regex("-dirty$"), "");
+  const auto git = run_command("git -C " + std::string(RIGCTL_SOURCE_DIR) + " describe --always --abbrev=12 2>/dev/null");
+  if (git.exit_code != 0) {
+    EXPECT_EQ(revision, "unknown") << "no git checkout: the fallback";
+    return;
+  }
+  EXPECT_EQ(revision, std::regex_replace(git.output, std::regex("\\s+$"), ""));
+}
+
 TEST_F(CliTest, FastAndPacedRunsGiveIdenticalLogs) {
   const auto paced = run_command(kRigctl + " run " + kConfig + " --duration 0.5 --log " + path("paced.lcm"));
   ASSERT_EQ(paced.exit_code, 0) << paced.output;

@@ -1,21 +1,19 @@
 #include "tools/rig_sim/rig_sim.hpp"
 
-#include <chrono>
-
 #include <algorithm>
-#include <cmath>
+#include <chrono>
 #include <memory>
-#include <random>
 #include <stdexcept>
+#include <thread>
 
 #include "config/config_reader.hpp"
 #include "config/rig_config.hpp"
-#include "drivers/sim/sensor_model.hpp"
 #include "drivers/sim/sim_canopen_valve.hpp"
 #include "drivers/sim/sim_modbus_daq.hpp"
 #include "rt/loop_clock.hpp"
 #include "rt/realtime.hpp"
-#include "tools/run/rig_assembly.hpp"
+#include "tools/rig_sim/fault_schedule.hpp"
+#include "tools/rig_sim/rig_sim_plant.hpp"
 
 namespace rigctl {
 
@@ -39,123 +37,30 @@ ModbusConnection far_side_connection(const RigSimOptions& o, ModbusConnection c)
   return c;
 }
 
-// The transducers of the physical rig: noise and offset on the plant's true
-// values. No ADC quantisation here: the DAQ's registers quantise.
-std::vector<SensorModel> transducers(const RigConfig& c, const ModbusDaqConfig& daq) {
-  std::vector<SensorModel> out;
-  for (const auto& ch : daq.inputs) {
-    SensorSpec spec;
-    if (const auto it = c.sensors.find(ch.name); it != c.sensors.end()) {
-      spec.noise_sd = it->second.noise_sd;
-      spec.offset = it->second.offset;
-    }
-    out.emplace_back(spec);
+// Free-running: one period per period of the monotonic clock.
+void run_paced(RigSimPlant& plant, const RigConfig& config, const RigSimOptions& o, const std::atomic<bool>& stop) {
+  MonotonicClock clock;
+  const auto period_ns = static_cast<int64_t>(config.loop.period_s * 1e9 + 0.5);
+  int64_t deadline = clock.now_ns();
+  for (int64_t tick = 0;; ++tick) {
+    const double t = plant.time(tick);
+    if (stop.load() || (o.duration_s && t >= *o.duration_s)) break;
+    plant.measure(t);
+    plant.take_command(t);
+    plant.report(tick, t);
+    plant.advance();
+    deadline += period_ns;
+    clock.sleep_until(deadline);
   }
-  return out;
 }
 
-int signal_index(const SimulatedPlant& plant, const std::string& name, const std::string& what) {
-  const auto& s = plant.signals();
-  for (std::size_t i = 0; i < s.size(); ++i) {
-    if (s[i].name == name) return static_cast<int>(i);
+// Lock-step: the DAQ's server thread steps the plant; this one waits for the
+// end (a signal, or --duration of plant time).
+void run_lock_step(RigSimPlant& plant, const RigSimOptions& o, const std::atomic<bool>& stop) {
+  while (!stop.load() && !(o.duration_s && plant.plant_time() >= *o.duration_s)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));  // only how soon a stop is seen
   }
-  throw std::invalid_argument(what + " '" + name + "' is not a signal of the simulated plant");
 }
-
-std::size_t daq_input_index(const ModbusDaqConfig& daq, const std::string& channel, const std::string& fault) {
-  for (std::size_t i = 0; i < daq.inputs.size(); ++i) {
-    if (daq.inputs[i].name == channel) return i;
-  }
-  throw std::invalid_argument("fault '" + fault + "': '" + channel + "' is not a DAQ input");
-}
-
-class FaultSchedule {
- public:
-  FaultSchedule(std::vector<FaultSpec> faults, SimModbusDaq& daq, SimCanopenValve* valve, std::ostream& out)
-      : faults_(std::move(faults)), started_(faults_.size(), false), ended_(faults_.size(), false), daq_(daq),
-        valve_(valve), out_(out) {
-    for (const auto& f : faults_) {
-      if (!fault_on_wire(f.kind)) {
-        throw std::invalid_argument("fault '" + f.text + "' is injected in the simulated driver: `rigctl run --fault` with driver: sim");
-      }
-      if ((f.kind == FaultKind::kHeartbeat || f.kind == FaultKind::kEmcy || f.kind == FaultKind::kHold) &&
-          valve_ == nullptr) {
-        throw std::invalid_argument("fault '" + f.text + "' needs the CANopen valve (--can-socket)");
-      }
-      if (f.kind == FaultKind::kException || f.kind == FaultKind::kStuck || f.kind == FaultKind::kRail) {
-        daq_input_index(daq_.client_config(), f.channel, f.text);  // fail before running
-      }
-    }
-  }
-
-  // Not on a real-time path of its own: rig-sim's plant thread calls it once
-  // per period; fault changes are rare.
-  void apply(double t) {
-    for (std::size_t i = 0; i < faults_.size(); ++i) {
-      const auto& f = faults_[i];
-      if (!started_[i] && t >= f.at_s) {
-        started_[i] = true;
-        begin(f);
-        out_ << "rig-sim: t = " << t << " s: fault " << f.text << "\n";
-        out_.flush();
-      }
-      if (started_[i] && !ended_[i] && f.duration_s > 0.0 && t >= f.at_s + f.duration_s) {
-        ended_[i] = true;
-        end(f);
-        out_ << "rig-sim: t = " << t << " s: fault " << f.text << " cleared\n";
-        out_.flush();
-      }
-    }
-  }
-
- private:
-  void begin(const FaultSpec& f) {
-    const auto cfg = daq_.client_config();
-    switch (f.kind) {
-      case FaultKind::kSilence: daq_.set_silent(true); break;
-      case FaultKind::kDrop: daq_.drop_connections(); break;
-      case FaultKind::kLate: daq_.set_reply_delay(f.delay_s); break;
-      case FaultKind::kException: {
-        const auto& p = cfg.inputs[daq_input_index(cfg, f.channel, f.text)].point;
-        daq_.add_exception({p.unit_id, p.type, p.address, p.address + register_count(p.format) - 1, f.code});
-        break;
-      }
-      case FaultKind::kStuck: daq_.set_stuck(daq_input_index(cfg, f.channel, f.text), true); break;
-      case FaultKind::kRail: {
-        // The top of the register's range: what an open-circuit transducer
-        // drives the ADC to.
-        const auto& p = cfg.inputs[daq_input_index(cfg, f.channel, f.text)].point;
-        const double rail = p.format == DataFormat::kInt16 ? 32767.0
-                            : p.format == DataFormat::kUint16 ? 65535.0
-                            : p.format == DataFormat::kInt32 ? 2147483647.0
-                            : p.format == DataFormat::kUint32 ? 4294967295.0
-                                                               : 3.0e38;
-        daq_.force_raw(daq_input_index(cfg, f.channel, f.text), rail);
-        break;
-      }
-      case FaultKind::kHeartbeat: valve_->miss_heartbeats(f.duration_s > 0.0 ? f.duration_s : 1e9); break;
-      case FaultKind::kEmcy:
-        valve_->send_emcy(static_cast<uint16_t>(f.code), static_cast<uint8_t>(f.error_register));
-        break;
-      case FaultKind::kHold: valve_->drop_to_hold(f.duration_s > 0.0 ? f.duration_s : 1e9); break;
-      default: break;  // not on the wire: refused by the constructor
-    }
-  }
-
-  void end(const FaultSpec& f) {
-    switch (f.kind) {
-      case FaultKind::kSilence: daq_.set_silent(false); break;
-      case FaultKind::kLate: daq_.set_reply_delay(0.0); break;
-      default: break;  // one-off or until the end
-    }
-  }
-
-  std::vector<FaultSpec> faults_;
-  std::vector<bool> started_, ended_;
-  SimModbusDaq& daq_;
-  SimCanopenValve* valve_;
-  std::ostream& out_;
-};
 
 }  // namespace
 
@@ -182,8 +87,6 @@ void run_rig_sim(const RigSimOptions& o, const std::atomic<bool>& stop, std::ost
   ModbusDaqConfig daq_config = *config.modbus;
   daq_config.connection = far_side_connection(o, daq_config.connection);
   SimModbusDaq daq(daq_config);
-  daq.start();
-  out << "rig-sim: modbus listening on " << daq.endpoint() << "\n";
 
   std::unique_ptr<SimCanopenValve> valve;
   if (with_valve) {
@@ -195,88 +98,23 @@ void run_rig_sim(const RigSimOptions& o, const std::atomic<bool>& stop, std::ost
     vc.spool_time_constant_s = 0.0;
     for (const auto& option : o.valve_options) apply_sim_valve_option(option, vc);
     valve = std::make_unique<SimCanopenValve>(o.can_socket, vc);
-    out << "rig-sim: canopen valve on " << o.can_socket << "\n";
   }
+  FaultSchedule faults(o.faults, daq, valve.get(), out);
+  RigSimPlant plant(config, daq_config, o, daq, valve.get(), faults, out);
+  if (o.lock_step) daq.set_exchange_hook([&plant] { plant.exchange(); });
+  daq.start();
+  out << "rig-sim: modbus listening on " << daq.endpoint() << (o.lock_step ? " (lock-step)" : "") << "\n";
+  if (valve) out << "rig-sim: canopen valve on " << o.can_socket << "\n";
   out.flush();
 
-  auto plant = make_plant(config);
-  plant->reset();
-  const auto& signals = plant->signals();
-  std::vector<int> plant_of_input;
-  for (const auto& ch : daq_config.inputs) plant_of_input.push_back(signal_index(*plant, ch.name, "DAQ input"));
-  int valve_daq_output = -1;
-  for (std::size_t i = 0; i < daq_config.outputs.size(); ++i) {
-    if (daq_config.outputs[i].name == plant->commands().at(0).name) valve_daq_output = static_cast<int>(i);
+  if (o.lock_step) {
+    run_lock_step(plant, o, stop);
+  } else {
+    run_paced(plant, config, o, stop);
   }
-  if (!with_valve && valve_daq_output < 0) {
-    throw ConfigError(config.file + ": modbus.outputs: no output named '" + plant->commands().at(0).name +
-                      "' drives the valve (or give --can-socket for a CANopen valve)");
-  }
-
-  FaultSchedule faults(o.faults, daq, valve.get(), out);
-  auto sensors = transducers(config, daq_config);
-  std::mt19937_64 rng(config.seed);
-  std::vector<double> truth(signals.size()), inputs(daq_config.inputs.size()), outputs(daq_config.outputs.size());
-  std::vector<double> command(plant->commands().size(), 0.0);
-
-  MonotonicClock clock;
-  const auto period_ns = static_cast<int64_t>(config.loop.period_s * 1e9 + 0.5);
-  const int64_t t0 = clock.now_ns();
-  int64_t deadline = t0;
-  double null_since = -1.0;
-  int64_t last_writes = 0;
-  double last_write_t = 0.0;
-  bool watchdog_tripped = false;
-  for (int64_t tick = 0;; ++tick) {
-    const double t = static_cast<double>(tick) * config.loop.period_s;
-    if (stop.load() || (o.duration_s && t >= *o.duration_s)) break;
-    faults.apply(t);
-    plant->measure(truth);
-    for (std::size_t i = 0; i < inputs.size(); ++i) {
-      inputs[i] = sensors[i].measure(truth[static_cast<std::size_t>(plant_of_input[i])], rng);
-    }
-    daq.set_inputs(inputs.data(), inputs.size());
-    if (with_valve) {
-      command[0] = valve->spool();
-    } else {
-      daq.outputs(outputs.data());
-      if (const int64_t w = daq.writes(); w != last_writes) {
-        last_writes = w;
-        last_write_t = t;
-        watchdog_tripped = false;
-      } else if (o.output_watchdog_s > 0.0 && t - last_write_t > o.output_watchdog_s) {
-        if (!watchdog_tripped) {
-          out << "rig-sim: t = " << t << " s: output watchdog: no write for " << o.output_watchdog_s
-              << " s, outputs at their safe values\n";
-          watchdog_tripped = true;
-        }
-        for (std::size_t i = 0; i < outputs.size(); ++i) outputs[i] = daq_config.outputs[i].safe;
-      }
-      command[0] = outputs[static_cast<std::size_t>(valve_daq_output)];
-    }
-    if (!std::isfinite(command[0])) command[0] = 0.0;
-    // Where the final stretch of null commands began: after a fault, the time
-    // the valve reached its safe value as the rig saw it (printed at the end).
-    if (command[0] != 0.0) {
-      null_since = -1.0;
-    } else if (null_since < 0.0) {
-      null_since = t;
-    }
-    // Twice a second, what the rig does: lets a person (and the end-to-end
-    // tests) see that a fault left the valve at null.
-    if (tick % std::max<int64_t>(1, std::llround(0.5 / config.loop.period_s)) == 0) {
-      out << "rig-sim: t = " << t << " s, valve " << plant->commands()[0].name << " = " << command[0];
-      for (std::size_t i = 0; i < inputs.size() && i < 3; ++i) out << ", " << daq_config.inputs[i].name << " = " << inputs[i];
-      out << "\n";
-      out.flush();
-    }
-    plant->advance(command, config.loop.period_s);
-    deadline += period_ns;
-    clock.sleep_until(deadline);
-  }
+  daq.stop();  // first: in lock-step its thread steps the plant, which reads the valve
   if (valve) valve.reset();
-  daq.stop();
-  if (null_since >= 0.0) out << "rig-sim: valve " << plant->commands()[0].name << " = 0 since t = " << null_since << " s\n";
+  if (plant.null_since() >= 0.0) out << "rig-sim: valve " << plant.valve_name() << " = 0 since t = " << plant.null_since() << " s\n";
   out << "rig-sim: stopped\n";
 }
 

@@ -30,6 +30,15 @@ struct RigSimOptions {
   // I/O modules do (a dead link cannot carry the controller's safe command).
   // 0: off.
   double output_watchdog_s = 0.1;
+  // Lock-step (tests, with `rigctl run --lock-step`): the plant steps one
+  // loop period per exchange with the controller, not by the clock. The
+  // exchange is the DAQ's read of the first input's registers: the first
+  // one answers the plant's initial state, each later one first steps the
+  // plant with the command written (or the CANopen valve's spool, once the
+  // valve has taken every frame sent before the request) and then answers.
+  // Plant time is then the controller's tick count, as in `run --fast`, and
+  // the faults' times are plant times.
+  bool lock_step = false;
 };
 
 // Prints "rig-sim: modbus listening on HOST:PORT" and "rig-sim: canopen

@@ -107,6 +107,9 @@ SimDriver* apply_run_options(AssembledRig& rig, const RigConfig& config, const R
   if (options.fast && !rig.driver->simulated()) {
     throw std::runtime_error("--fast needs a simulated driver: '" + std::string(to_string(config.driver)) + "' runs real hardware in real time");
   }
+  if (options.lock_step && !config.modbus) {
+    throw std::runtime_error("--lock-step needs a Modbus DAQ (driver: modbus or modbus_canopen) and `rigctl rig-sim --lock-step` on its far side");
+  }
   // Injected faults (drivers/sim/sim_faults.hpp): the config's `faults:`, then --fault.
   std::vector<FaultSpec> faults = config.faults;
   faults.insert(faults.end(), options.faults.begin(), options.faults.end());
@@ -169,7 +172,7 @@ void print_run_header(const RigConfig& config, const RunOptions& options, const 
   out << "rigctl run: " << config.rig << " (" << config.driver << " driver) from " << options.config_path
       << (options.case_name.empty() ? "" : " case " + options.case_name) << ", "
       << (length.unbounded ? std::string("until stopped") : fmt::format("{:g} s", length.duration_s)) << " "
-      << (options.fast ? "as fast as possible" : "paced by the real clock") << "\n"
+      << (options.fast ? "as fast as possible" : options.lock_step ? "in lock-step with rig-sim" : "paced by the real clock") << "\n"
       << "  telemetry: " << url << " channels " << config.telemetry.channel_prefix << "*, a full queue "
       << (meta.queue_policy == QueueFullPolicy::kWait ? "holds the loop back (simulated time: nothing is dropped)"
                                                        : "drops and counts (the tick never waits)")
@@ -193,7 +196,7 @@ void print_run_summary(const RigConfig& config, const RunOptions& options, const
   out << "  ended: " << to_string(result.final_state) << " (" << report.end_reason << ") after " << result.ticks << " ticks ("
       << std::fixed << std::setprecision(3) << static_cast<double>(result.ticks) * config.loop.period_s
       << " s rig time, " << report.wall_s << " s wall), rig state " << to_string(result.final_safety_state) << "\n";
-  if (!options.fast) {
+  if (!options.fast && !options.lock_step) {
     out << "  wake-up latency: " << describe(t.wakeup_latency) << "\n"
         << "  compute per tick: " << describe(t.compute) << "\n"
         << "    longest per step: " << describe_stages(t.stages.max_ns) << "\n"
@@ -232,13 +235,25 @@ void print_run_records(const RunReport& report, const TelemetryPublisher& publis
   if (publisher.log_failures() > 0) out << "  run log write failures: " << publisher.log_failures() << "\n";
 }
 
+// --lock-step: the DAQ cycles once per tick, its poll period the loop's.
+RigConfig lock_step_config(RigConfig config) {
+  if (config.modbus) {
+    config.modbus->lock_step = true;
+    config.modbus->poll_period_s = config.loop.period_s;
+  }
+  return config;
+}
+
 }  // namespace
 
 RunReport run_rig(const RunOptions& options, const std::atomic<bool>& stop, std::ostream& out) {
   return run_rig(load_rig_config(options.config_path, options.case_name), options, stop, out);
 }
 
-RunReport run_rig(const RigConfig& config, const RunOptions& options, const std::atomic<bool>& stop, std::ostream& out) {
+RunReport run_rig(const RigConfig& config_file, const RunOptions& options, const std::atomic<bool>& stop, std::ostream& out) {
+  const RigConfig config = options.lock_step ? lock_step_config(config_file) : config_file;
+  // Simulated time: the loop's clock is the tick count (--fast, --lock-step).
+  const bool simulated_time = options.fast || options.lock_step;
   AssembledRig rig = assemble_rig(config);
   SimDriver* sim = apply_run_options(rig, config, options);
 
@@ -267,7 +282,7 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
   } else if (!options.resume_path.empty()) {
     throw std::runtime_error("--resume continues a procedure: give its --procedure too");
   }
-  const TelemetryMeta meta = telemetry_meta_for(config, rig, loop_options, options.fast);
+  const TelemetryMeta meta = telemetry_meta_for(config, rig, loop_options, simulated_time);
   const std::string url = options.lcm_url.empty() ? config.telemetry.lcm_url : options.lcm_url;
   // Ten seconds of records: a paced run's publisher thread would have to
   // stall that long before the loop drops telemetry.
@@ -348,7 +363,7 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
 
   MonotonicClock monotonic;
   VirtualClock virtual_clock;
-  LoopClock& clock = options.fast ? static_cast<LoopClock&>(virtual_clock) : monotonic;
+  LoopClock& clock = simulated_time ? static_cast<LoopClock&>(virtual_clock) : monotonic;
   if (sim != nullptr) sim->set_stall_clock(&clock);  // an overrun fault stalls the loop's own clock
 
   const auto wall_start = std::chrono::steady_clock::now();
@@ -359,12 +374,12 @@ RunReport run_rig(const RigConfig& config, const RunOptions& options, const std:
     RealtimeConfig rt = config.loop.realtime;
     rt.enabled = rt.enabled && options.realtime;
     std::optional<RealtimeSession> session;
-    if (!options.fast) {
+    if (!simulated_time) {
       session.emplace(rt);
       for (const auto& w : session->warnings()) spdlog::warn("{}", w);
     }
     std::optional<ConsoleStatus> status;
-    if (!options.fast) {
+    if (!simulated_time) {
       status.emplace(publisher, meta, rig.driver->layout().input_index(config.controller.feedback),
                      length.unbounded ? std::numeric_limits<double>::infinity() : length.duration_s, out);
     }

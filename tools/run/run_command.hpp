@@ -26,6 +26,9 @@ struct RunOptions {
   std::string case_name;             // a `cases:` entry of the config, "" for none
   std::optional<double> duration_s;  // default: the profile's length; operator mode: until the operator ends it
   bool fast = false;                 // simulated plant only: no pacing
+  // Hardware driver against `rigctl rig-sim --lock-step` (tests): simulated
+  // time as with --fast, one DAQ cycle per tick (ModbusDaqConfig::lock_step).
+  bool lock_step = false;
   // Telemetry records the loop can hand over before the queue is full;
   // 0: ten seconds of ticks. A small queue shows the full-queue policy at work.
   std::size_t telemetry_queue_records = 0;

@@ -496,6 +496,45 @@ TEST_F(ModbusDaqTest, IoLatencyIsMeasured) {
   EXPECT_EQ(counter("modbus_reconnects"), 0);
 }
 
+// Lock-step (`rigctl run --lock-step` against `rig-sim --lock-step`): after
+// start()'s sample, each read_inputs() is one exchange, outputs first, so
+// the far side's exchange k sees the command posted before read k and read
+// k returns what exchange k put in the registers, whatever the clock does.
+TEST(ModbusDaqLockStep, EachReadIsOneExchangeThatCarriesTheCommandBeforeIt) {
+  SimModbusDaq sim(rig_config());
+  std::vector<double> seen;  // the far side's u at each exchange (its server thread; read after stop)
+  std::vector<double> values = kValuesA;
+  int64_t exchanges = 0;
+  sim.set_exchange_hook([&] {
+    double out[2] = {0, 0};
+    sim.outputs(out);
+    seen.push_back(out[0]);
+    values[0] = 1e-3 * static_cast<double>(exchanges++);  // input a: the exchange's number
+    sim.set_inputs(values.data(), values.size());
+  });
+  sim.start();
+  ModbusDaqConfig c = sim.client_config();
+  c.lock_step = true;
+  ModbusDaq daq(c);
+  daq.start(10.0);
+  constexpr int kReads = 50;
+  for (int k = 0; k < kReads; ++k) {
+    Sample s;
+    daq.read_inputs(s, 0, ModbusDaq::now_ns());
+    EXPECT_EQ(s.status, 0u) << "read " << k << ": every input from this read's exchange";
+    EXPECT_NEAR(s.value[0], 1e-3 * k, 0.5e-4) << "read " << k << " is exchange " << k;
+    const double u = 0.01 * (k + 1);
+    daq.write_outputs(&u, 1);
+  }
+  daq.stop();  // its last act writes the safe values: a write, not an exchange
+  sim.stop();
+  ASSERT_EQ(seen.size(), static_cast<std::size_t>(kReads)) << "start()'s read and one per later read";
+  EXPECT_EQ(seen[0], 0.0) << "start() wrote the safe value";
+  for (std::size_t k = 1; k < seen.size(); ++k) {
+    EXPECT_NEAR(seen[k], 0.01 * static_cast<double>(k), 3.1e-5) << "exchange " << k << " carries read " << k - 1 << "'s command";
+  }
+}
+
 TEST(ModbusDaqStart, AgainstAClosedPortThrowsNamingHostAndPort) {
   // A port nobody listens on: bind one, note it, close it.
   const int fd = socket(AF_INET, SOCK_STREAM, 0);

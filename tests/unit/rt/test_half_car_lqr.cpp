@@ -10,6 +10,7 @@
 
 #include "plant/half_car/half_car_model.hpp"
 #include "rt/control/lqr_controller.hpp"
+#include "rt/control/lqr_design.hpp"
 #include "rt/control/lqr_riccati.hpp"
 
 using namespace rigctl;
