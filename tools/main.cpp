@@ -27,7 +27,8 @@
 #include "tools/rig_sim/rig_sim.hpp"
 #include "tools/run/run_command.hpp"
 #include "tools/suspension/compare_command.hpp"
-#include "generated/rigctl_version.hpp"  // cmake/version.cmake: version and git revision
+#include "generated/rigctl_version.hpp"  // cmake/version.cmake: the version
+#include "tools/common/revision.hpp"
 
 namespace {
 
@@ -58,7 +59,7 @@ std::vector<std::pair<std::string, double>> parse_effects(const std::vector<std:
 int main(int argc, char** argv) {
   CLI::App app{"rigctl: real-time controller and simulator for servo-hydraulic and pneumatic test rigs"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", RIGCTL_VERSION_TEXT);
+  app.set_version_flag("--version", std::string("rigctl ") + RIGCTL_VERSION + " (git " + rigctl::rigctl_revision() + ")");
 
   rigctl::RunOptions run;
   double duration = 0.0;

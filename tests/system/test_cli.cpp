@@ -54,9 +54,9 @@ TEST_F(CliTest, HelpListsTheSubcommands) {
 }
 
 // `rigctl --version`: the project's version and the git revision the build
-// was configured from (cmake/version.cmake), which is the checkout's own
-// `git describe` (configuring again follows each commit; "-dirty" is the
-// state at configure time, so it is not compared).
+// saw (tools/scripts/revision.cmake, rewritten at every build), which is the
+// checkout's own `git describe` ("-dirty" is the state at build time, so it
+// is not compared).
 TEST_F(CliTest, VersionNamesTheVersionAndTheGitRevision) {
   const auto r = run_command(kRigctl + " --version");
   ASSERT_EQ(r.exit_code, 0) << r.output;
