@@ -10,7 +10,9 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <iterator>
 #include <memory>
@@ -71,9 +73,13 @@ inline double last_time(const std::string& csv) {
 class RigSimTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("rigctl_wire_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    // The test's name hashed, not spelt out: the valve's socket lives in this
+    // folder, and a Unix socket's path has at most 107 characters (a long
+    // test name made rig-sim refuse canopen.socket_path).
+    const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    char hash[17];
+    std::snprintf(hash, sizeof hash, "%016zx", std::hash<std::string>{}(test));
+    dir_ = std::filesystem::temp_directory_path() / ("rigctl_wire_" + std::to_string(::getpid()) + "_" + hash);
     std::filesystem::create_directories(dir_);
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }

@@ -170,7 +170,11 @@ TEST_F(HostileClients, FloodsOversizedFramesAndTheLimitAreRefusedWhileAGoodClien
   EXPECT_EQ(r["crossOrigin"], 403);
   EXPECT_EQ(r["sameOrigin"], 101);   // the server's own page
   EXPECT_EQ(r["reboundHost"], 403);  // another name for 127.0.0.1
-  EXPECT_EQ(r["oversized"]["code"], 1009) << r["oversized"];
+  // 1009 when the server's close frame reaches the client; 1006 when the
+  // server's close of a socket still holding the client's unread megabyte
+  // resets the connection first (a race of the two machines' TCP stacks, seen
+  // under load). The server's own count below is what says it refused it.
+  EXPECT_TRUE(r["oversized"]["code"] == 1009 || r["oversized"]["code"] == 1006) << r["oversized"];
   EXPECT_GT(r["flood"]["sent"].get<int>(), 0);
   EXPECT_LT(r["flood"]["sent"].get<int>(), 200000) << "the flooder was never closed";
   EXPECT_TRUE(r["slowFrame"]["upgraded"].get<bool>()) << r["slowFrame"];
