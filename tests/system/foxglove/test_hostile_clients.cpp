@@ -176,7 +176,11 @@ TEST_F(HostileClients, FloodsOversizedFramesAndTheLimitAreRefusedWhileAGoodClien
   // under load). The server's own count below is what says it refused it.
   EXPECT_TRUE(r["oversized"]["code"] == 1009 || r["oversized"]["code"] == 1006) << r["oversized"];
   EXPECT_GT(r["flood"]["sent"].get<int>(), 0);
-  EXPECT_LT(r["flood"]["sent"].get<int>(), 200000) << "the flooder was never closed";
+  // Closed by the server (a close seen within the script's deadline; the
+  // report's queue_overflow below says why). Not judged by how many requests
+  // the client had queued by then: on a busy machine the client queues all
+  // of them before the server has read enough to overflow.
+  EXPECT_TRUE(r["flood"].contains("code")) << r["flood"];
   EXPECT_TRUE(r["slowFrame"]["upgraded"].get<bool>()) << r["slowFrame"];
   EXPECT_LT(r["slowFrame"]["bytesSent"].get<int>(), 100) << r["slowFrame"];  // closed before the frame was complete
   EXPECT_EQ(r["pastTheLimit"], 503);
