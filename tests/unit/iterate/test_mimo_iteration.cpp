@@ -8,13 +8,13 @@
 
 #include <cmath>
 #include <numbers>
-#include <random>
 
 #include "tools/identify/mimo_excitation.hpp"
 #include "tools/identify/mimo_frf.hpp"
 #include "tools/iterate/mimo_iteration.hpp"
 #include "tools/iterate/spectrum.hpp"
 #include "two_poster_linear_rig.hpp"
+#include "two_poster_road.hpp"
 
 namespace rigctl {
 namespace {
@@ -71,37 +71,8 @@ MimoFrf model_frf(const TwoPosterLinearRig& rig) {
   return frf;
 }
 
-// A road as both posters see it, 0.5-20 Hz with a 1/f^2 displacement
-// spectrum, the rear post the front's road 0.134 s later (wheelbase 2.68 m
-// at 20 m/s) plus its own part (the other wheel track), ends tapered; what
-// the body does over the axles on this road is the target.
-Records track_target(const TwoPosterLinearRig& rig) {
-  const std::size_t n = 8000;  // 20 s
-  std::mt19937_64 rng(21);
-  std::normal_distribution<double> normal;
-  auto road = [&] {
-    std::vector<double> w(n);
-    for (double& v : w) v = normal(rng);
-    Spectrum s = forward_fft(w);
-    for (std::size_t k = 0; k < n; ++k) {
-      const double f = bin_frequency_hz(k, n, kPeriod);
-      s[k] *= (f < 0.5 || f > 20.0) ? 0.0 : 1.0 / (f * f);
-    }
-    return inverse_fft(s);
-  };
-  const auto front = road(), side = road();
-  const auto delay = static_cast<std::size_t>(std::lround(0.134 / kPeriod));
-  Records drives(2, std::vector<double>(n, 0.0));
-  double rms = 0.0;
-  for (std::size_t i = 0; i < n; ++i) rms += front[i] * front[i];
-  const double scale = 0.004 / std::sqrt(rms / n);  // 4 mm rms
-  for (std::size_t i = 0; i < n; ++i) {
-    const double taper = std::min({1.0, i / 400.0, (n - 1 - i) / 400.0});
-    drives[0][i] = scale * taper * front[i];
-    drives[1][i] = scale * taper * (0.7 * (i >= delay ? front[i - delay] : 0.0) + 0.3 * side[i]);
-  }
-  return rig.play(drives, 99);
-}
+// What the body does over the axles on a road (tests/support/two_poster_road.hpp, 4 mm rms).
+Records track_target(const TwoPosterLinearRig& rig) { return rig.play(test::two_poster_road(0.004, kPeriod), 99); }
 
 bool each_better_than_the_last(const MimoIterationResult& r) {
   for (std::size_t it = 1; it < r.error.size(); ++it) {

@@ -8,7 +8,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <random>
 
 #include "plant/two_poster/two_poster_plant.hpp"
 #include "tools/identify/mimo_excitation.hpp"
@@ -16,6 +15,7 @@
 #include "tools/iterate/mimo_iteration.hpp"
 #include "tools/iterate/spectrum.hpp"
 #include "two_poster_loops.hpp"
+#include "two_poster_road.hpp"
 
 namespace rigctl {
 namespace {
@@ -50,35 +50,8 @@ MimoFrf measured_frf(const TwoPosterParams& params) {
   return estimate_mimo_frf({drives.begin(), drives.end()}, {responses.begin(), responses.end()}, welch, 0.5, 20.0, lines);
 }
 
-// A road under both axles (0.5-20 Hz, 1/f^2 displacement, 3 mm rms, the
-// rear the front's 0.134 s later plus its own part), around 20 mm up.
-Records track_target(const TwoPosterParams& params) {
-  const std::size_t n = 8000;
-  std::mt19937_64 rng(21);
-  std::normal_distribution<double> normal;
-  auto road = [&] {
-    std::vector<double> w(n);
-    for (double& v : w) v = normal(rng);
-    Spectrum s = forward_fft(w);
-    for (std::size_t k = 0; k < n; ++k) {
-      const double f = bin_frequency_hz(k, n, kPeriod);
-      s[k] *= (f < 0.5 || f > 20.0) ? 0.0 : 1.0 / (f * f);
-    }
-    return inverse_fft(s);
-  };
-  const auto front = road(), side = road();
-  double rms = 0.0;
-  for (double v : front) rms += v * v;
-  const double scale = 0.003 / std::sqrt(rms / n);
-  const auto delay = static_cast<std::size_t>(std::lround(0.134 / kPeriod));
-  Records drives(2, std::vector<double>(n));
-  for (std::size_t i = 0; i < n; ++i) {
-    const double taper = std::min({1.0, i / 400.0, (n - 1 - i) / 400.0});
-    drives[0][i] = scale * taper * front[i];
-    drives[1][i] = scale * taper * (0.7 * (i >= delay ? front[i - delay] : 0.0) + 0.3 * side[i]);
-  }
-  return play(params, drives);
-}
+// What the body does over the axles on a road (tests/support/two_poster_road.hpp, 3 mm rms).
+Records track_target(const TwoPosterParams& params) { return play(params, test::two_poster_road(0.003, kPeriod)); }
 
 void expect_reached(const MimoFrf& frf, const TwoPosterParams& rig) {
   const auto target = track_target(rig);
