@@ -14,6 +14,7 @@
 #include <fstream>
 #include <numbers>
 
+#include "iteration_run.hpp"
 #include "process.hpp"
 #include "tools/iterate/rpc3_file.hpp"
 #include "tools/runfile/run_file.hpp"
@@ -21,22 +22,11 @@
 namespace rigctl {
 namespace {
 
-const std::string kConfig = std::string(RIGCTL_SOURCE_DIR) + "/config/quarter_car.yaml";
+const std::string kConfig = test::kQuarterCarConfig;
 
-std::string fresh_dir(const std::string& name) {
-  const auto dir = std::filesystem::path(::testing::TempDir()) / ("drive-iteration-" + name);
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir.string();
-}
-
-test::ProcessResult rigctl(const std::string& args) { return test::run_command(std::string(RIGCTL_BINARY) + " " + args); }
-
-nlohmann::json summary_of(const std::string& out_dir) {
-  std::ifstream f(out_dir + "/summary.json");
-  EXPECT_TRUE(f.good()) << "no summary.json in " << out_dir;
-  return nlohmann::json::parse(f);
-}
+std::string fresh_dir(const std::string& name) { return test::fresh_dir("drive-iteration", name); }
+using test::rigctl;
+using test::summary_of;
 
 // Class C road at 2 m/s: the wheel's peak velocity (0.1 m/s) leaves the
 // drive, which must lead the wheel through the loop, room inside the 20

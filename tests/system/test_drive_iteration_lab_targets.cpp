@@ -20,27 +20,17 @@
 #include <numbers>
 #include <random>
 
+#include "iteration_run.hpp"
 #include "process.hpp"
 
 namespace rigctl {
 namespace {
 
-const std::string kConfig = std::string(RIGCTL_SOURCE_DIR) + "/config/quarter_car.yaml";
+const std::string kConfig = test::kQuarterCarConfig;
 
-std::string fresh_dir(const std::string& name) {
-  const auto dir = std::filesystem::path(::testing::TempDir()) / ("lab-targets-" + name);
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir.string();
-}
-
-test::ProcessResult rigctl(const std::string& args) { return test::run_command(std::string(RIGCTL_BINARY) + " " + args); }
-
-nlohmann::json summary_of(const std::string& out_dir) {
-  std::ifstream f(out_dir + "/summary.json");
-  EXPECT_TRUE(f.good()) << "no summary.json in " << out_dir;
-  return nlohmann::json::parse(f);
-}
+std::string fresh_dir(const std::string& name) { return test::fresh_dir("lab-targets", name); }
+using test::rigctl;
+using test::summary_of;
 
 // ---- The target, as a function of time (so any sample rate can be written) ----
 
