@@ -29,7 +29,7 @@ constexpr double kStartTimeoutS = 120.0;
 constexpr double kRunTimeoutS = 300.0;
 
 class FoxgloveServer : public ::testing::Test {
- public:  // also for run_pair below
+ public:
   void SetUp() override {
     dir_ = fs::temp_directory_path() / ("rigctl_foxglove_" + std::to_string(::getpid()) + "_" +
                                         ::testing::UnitTest::GetInstance()->current_test_info()->name());
@@ -161,29 +161,27 @@ int64_t number_after(const std::string& text, const std::string& pattern) {
   return std::stoll(m[1].str());
 }
 
-struct PairResult {
-  int64_t overruns_alone = -1, overruns_served = -1;
-  bool realtime = true;  // both loops ran at SCHED_FIFO
-};
-
 // One run alone, one with a client that stops reading after its first
 // message; the server from the config's telemetry.websocket, with a small
-// client queue so the client's share fills early in the run.
-PairResult run_pair(FoxgloveServer& t, int attempt) {
-  const std::string tag = std::to_string(attempt);
-  auto alone = t.start_run("alone" + tag, {"--duration", "4"});
+// client queue so the client's share fills early in the run. What is
+// asserted is what a stalled client could break and the scheduler cannot:
+// the server dropped the client's messages instead of waiting for it, and the
+// run's log is the same message for message. Whether the loop kept its
+// deadlines beside such a client is a timing question; it is measured in
+// docs/benchmarks/foxglove-limits.md, not asserted here.
+TEST_F(FoxgloveServer, AClientThatStopsReadingLeavesTheRunLogAsWithoutIt) {
+  auto alone = start_run("alone", {"--duration", "4"});
   EXPECT_EQ(alone->wait(), 0) << alone->output();
 
   const int port = free_tcp_port();
-  t.write_config("served.yaml", edit(without_overrun_stop(shipped_config()), "(  log_dir: runs[^\n]*\n)",
-                                     "$1  websocket: {port: " + std::to_string(port) + ", client_queue: 64}\n"));
-  auto client = t.start_client("stalled" + tag, port, {"--subprotocol", "foxglove.websocket.v1", "--topic",
-                                                      "RIGCTL_SAMPLE", "--subscribe-all", "--stall"});
-  auto served = t.start_run("served" + tag, {"--duration", "4"});
+  write_config("served.yaml", edit(without_overrun_stop(shipped_config()), "(  log_dir: runs[^\n]*\n)",
+                                   "$1  websocket: {port: " + std::to_string(port) + ", client_queue: 64}\n"));
+  auto client = start_client("stalled", port, {"--subprotocol", "foxglove.websocket.v1", "--topic", "RIGCTL_SAMPLE",
+                                               "--subscribe-all", "--stall"});
+  auto served = start_run("served", {"--duration", "4"});
   EXPECT_TRUE(client->wait_for("stalled", kRunTimeoutS)) << client->output();
   EXPECT_EQ(served->wait(), 0) << served->output();
   client->stop();
-  t.write_config("quarter_car.yaml", without_overrun_stop(shipped_config()));
 
   const std::string a = alone->output(), b = served->output();
   // The client was served and then lost messages: its queue dropped them,
@@ -191,8 +189,8 @@ PairResult run_pair(FoxgloveServer& t, int attempt) {
   const int64_t dropped = number_after(b, R"(127\.0\.0\.1:\d+ \(foxglove\.websocket\.v1\): \d+ sent, (\d+) dropped)");
   EXPECT_GT(dropped, 0) << "the stalled client's queue never filled: the test did not exercise it\n" << b;
   // The log has the same data; nothing was dropped on its way.
-  const auto log_a = data_messages(t.path("alone" + tag + ".lcm"));
-  const auto log_b = data_messages(t.path("served" + tag + ".lcm"));
+  const auto log_a = data_messages(path("alone.lcm"));
+  const auto log_b = data_messages(path("served.lcm"));
   EXPECT_GE(log_a.size(), 3u * 1600u);  // 4 s at 400 Hz, three data channels
   EXPECT_EQ(log_a.size(), log_b.size());
   for (std::size_t i = 0; i < std::min(log_a.size(), log_b.size()); ++i) {
@@ -203,26 +201,6 @@ PairResult run_pair(FoxgloveServer& t, int attempt) {
   }
   EXPECT_EQ(a.find("records dropped"), std::string::npos) << a;
   EXPECT_EQ(b.find("records dropped"), std::string::npos) << b;
-  const std::regex refused(R"(SCHED_FIFO priority \d+ refused)");
-  return {number_after(a, R"(overruns: (\d+))"), number_after(b, R"(overruns: (\d+))"),
-          !std::regex_search(a, refused) && !std::regex_search(b, refused)};
-}
-
-TEST_F(FoxgloveServer, AClientThatStopsReadingLeavesTheRunLogAsWithoutIt) {
-  // The same overruns: only a loop at real-time priority keeps its deadlines
-  // on a loaded machine (without SCHED_FIFO the count measures the
-  // scheduler). On a machine shared with other builds a late wake-up can
-  // still come from them, in either run: the pair is run again, up to three
-  // times. A client that cost the loop ticks would cost them every time.
-  std::vector<std::string> seen;
-  for (int attempt = 1; attempt <= 3; ++attempt) {
-    const PairResult r = run_pair(*this, attempt);
-    if (HasFailure() || !r.realtime || r.overruns_alone == r.overruns_served) return;
-    seen.push_back(std::to_string(r.overruns_alone) + " alone vs " + std::to_string(r.overruns_served) + " served");
-  }
-  std::string all;
-  for (const auto& s : seen) all += "\n  " + s;
-  ADD_FAILURE() << "the overrun counts differed in every attempt:" << all;
 }
 
 }  // namespace
