@@ -58,7 +58,7 @@ void expect_round_trip(const std::vector<std::string>& names, const std::set<Kin
   EXPECT_THROW(parse_kind<Kind>("no_such_kind"), std::invalid_argument);
 }
 
-TEST(Kinds, RigKindNamesRoundTrip) { expect_round_trip<RigKind>({"quarter_car", "pneumatic_rotary", "half_car"}); }
+TEST(Kinds, RigKindNamesRoundTrip) { expect_round_trip<RigKind>({"quarter_car", "pneumatic_rotary", "half_car", "two_poster"}); }
 
 TEST(Kinds, DriverKindNamesRoundTrip) { expect_round_trip<DriverKind>({"sim", "modbus", "modbus_canopen"}); }
 
