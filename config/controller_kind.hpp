@@ -61,6 +61,9 @@ constexpr RigKind rig_of(ControllerKind k) {
 
 // The controllers of a rig kind, in enumerator order.
 std::vector<ControllerKind> controllers_of(RigKind rig);
+// Whether a rig kind may run a controller kind: its own (rig_of), and on the
+// two-poster, whose posts are position loops, pi and pvp.
+bool runs_on(ControllerKind k, RigKind rig);
 
 // Reads a controller kind at `key` for a rig kind: an unknown name, or a
 // controller of another rig, is a ConfigError naming file, line and key.

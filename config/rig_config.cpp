@@ -222,6 +222,37 @@ std::map<std::string, SensorSpec> read_converters(ConfigReader r, bool sensor) {
   return out;
 }
 
+// One control channel (`controller:` and `profile:`), or several: a
+// `channels:` list with one {controller, profile} per actuator, the first of
+// which is the rig's first channel.
+void read_channels(ConfigReader& root, RigConfig& c) {
+  if (!root.has("channels")) {
+    c.controller = read_controller(root.child("controller"), c.rig, c.loop.period_s);
+    c.profile = read_profile(root.child("profile"), c.file);
+    return;
+  }
+  for (const char* single : {"controller", "profile"}) {
+    if (root.has(single)) root.fail(single, "give either `channels:` or `controller:` and `profile:`, not both");
+  }
+  auto items = root.items("channels");
+  if (items.empty()) root.fail("channels", "expected at least one channel");
+  if (items.size() > kMaxChannels) {
+    root.fail("channels", std::to_string(items.size()) + " channels, at most " + std::to_string(kMaxChannels));
+  }
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    ChannelConfig ch;
+    ch.controller = read_controller(items[i].child("controller"), c.rig, c.loop.period_s);
+    ch.profile = read_profile(items[i].child("profile"), c.file);
+    items[i].reject_unknown_keys();
+    if (i == 0) {
+      c.controller = ch.controller;
+      c.profile = ch.profile;
+    } else {
+      c.more_channels.push_back(ch);
+    }
+  }
+}
+
 RigConfig parse(ConfigReader root, const std::string& case_name) {
   RigConfig c;
   c.file = root.file();
@@ -231,8 +262,7 @@ RigConfig parse(ConfigReader root, const std::string& case_name) {
   c.seed = static_cast<uint64_t>(root.integer("seed", 0, std::numeric_limits<int64_t>::max()));
   c.loop = read_loop(root.child("loop"));
   c.telemetry = read_telemetry(root.child("telemetry"));
-  c.controller = read_controller(root.child("controller"), c.rig, c.loop.period_s);
-  c.profile = read_profile(root.child("profile"), c.file);
+  read_channels(root, c);
   if (root.has("limits")) c.limits = read_limits(root.child("limits"));
   if (root.has("safety")) c.safety = read_safety(root.child("safety"));
   if (root.has("operator")) c.operator_commands = read_operator(root.child("operator"), c.file);
@@ -254,6 +284,9 @@ RigConfig parse(ConfigReader root, const std::string& case_name) {
       read_half_car_plant(root.child("plant"), c.half_car);
       c.suspension_report = read_suspension_report(root.child("report"));
       c.suspension_optimize = read_suspension_optimize(root.child("optimize"));
+      break;
+    case RigKind::kTwoPoster:
+      read_two_poster_plant(root.child("plant"), c.two_poster);
       break;
   }
   c.sensors = read_converters(root.child("sensors"), true);

@@ -23,6 +23,7 @@
 #include "plant/half_car/half_car_params.hpp"
 #include "plant/pneumatic_rotary/pneumatic_rotary_params.hpp"
 #include "plant/quarter_car/quarter_car_params.hpp"
+#include "plant/two_poster/two_poster_plant.hpp"
 #include "rt/safety/limit_action.hpp"
 #include "rt/control/pi_controller.hpp"
 #include "rt/control/pvp_controller.hpp"
@@ -98,6 +99,13 @@ struct ProfileConfig {
   double value = 0.0, duration_s = 0.0;  // hold: a constant demand for duration_s
 };
 
+// A control channel after the first of a rig with several actuators
+// (`channels:`, a list whose first entry is `controller`/`profile`).
+struct ChannelConfig {
+  ControllerConfig controller;
+  ProfileConfig profile;
+};
+
 struct LimitConfig {
   std::string channel;
   double min = 0.0, max = 0.0;
@@ -148,8 +156,11 @@ struct RigConfig {
   uint64_t seed = 1;
   LoopConfig loop;
   TelemetryConfig telemetry;
+  // The first control channel: `controller:` and `profile:`, or the first
+  // entry of `channels:` (a list of {controller, profile}, one per actuator).
   ControllerConfig controller;
   ProfileConfig profile;
+  std::vector<ChannelConfig> more_channels;  // `channels:` after the first; empty for one channel
   std::vector<LimitConfig> limits;
   SafetyConfig safety;  // `safety:`; optional, defaults as SafetyConfig{}
   OperatorConfig operator_commands;  // `operator:`; optional (config/operator_config.hpp)
@@ -159,6 +170,7 @@ struct RigConfig {
   QuarterCarParams quarter_car;          // rig quarter_car
   PneumaticRotaryParams pneumatic_rotary;  // rig pneumatic_rotary
   HalfCarParams half_car;                  // rig half_car
+  TwoPosterParams two_poster;              // rig two_poster
   SuspensionReportConfig suspension_report;      // half_car `report:` (rigctl compare)
   SuspensionOptimizeConfig suspension_optimize;  // half_car `optimize:` (rigctl optimize)
   std::map<std::string, SensorSpec> sensors;  // by channel name

@@ -15,6 +15,7 @@ enum class RigKind : uint8_t {
   kQuarterCar,       // hydraulic road simulator under a passive quarter car (seed paper 000)
   kPneumaticRotary,  // flexible-bladder rotary servo (seed paper 002)
   kHalfCar,          // half vehicle with active suspension (seed paper 001)
+  kTwoPoster,        // seed 001's half car on two hydraulic posts like seed 000's (docs/rig-models.md 4)
 };
 
 constexpr std::string_view to_string(RigKind k) {
@@ -22,6 +23,7 @@ constexpr std::string_view to_string(RigKind k) {
     case RigKind::kQuarterCar: return "quarter_car";
     case RigKind::kPneumaticRotary: return "pneumatic_rotary";
     case RigKind::kHalfCar: return "half_car";
+    case RigKind::kTwoPoster: return "two_poster";
   }
   return "unknown";
 }
@@ -29,7 +31,7 @@ constexpr std::string_view to_string(RigKind k) {
 template <>
 struct KindNames<RigKind> {
   static constexpr std::string_view noun = "rig kind";
-  static constexpr std::array known{RigKind::kQuarterCar, RigKind::kPneumaticRotary, RigKind::kHalfCar};
+  static constexpr std::array known{RigKind::kQuarterCar, RigKind::kPneumaticRotary, RigKind::kHalfCar, RigKind::kTwoPoster};
 };
 
 }  // namespace rigctl

@@ -13,7 +13,11 @@ namespace rigctl {
 
 // Enough for the half-car's two-post rig plus simulator truth channels.
 inline constexpr std::size_t kMaxInputs = 24;
-inline constexpr std::size_t kMaxOutputs = 4;
+// Eight valves: two four-posters in one loop (the bench's largest rig).
+inline constexpr std::size_t kMaxOutputs = 8;
+// Control channels of one loop: each its own feedback, controller, demand
+// and output (a two-poster road simulator has two). One per output at most.
+inline constexpr std::size_t kMaxChannels = kMaxOutputs;
 
 // One named signal in SI units. Built once at start-up, never on the tick path.
 struct ChannelInfo {

@@ -29,6 +29,16 @@ struct ControllerTerms {
   bool integrator_held = false;  // anti-windup is holding the integrator this tick
 };
 
+// A control channel after the first, in brief: what the channels' message
+// (lcmtypes/rigctl_channels_t.lcm) and the run file's x_ref_2... carry.
+// Small, so the record a one-channel rig copies each tick stays small.
+struct ChannelTerms {
+  double setpoint = 0.0;
+  double measurement = 0.0;
+  double output = 0.0;  // the channel's first output as commanded
+  bool saturated = false;
+};
+
 // Something that happened on this tick. Codes, not text: the publisher
 // formats the message off the real-time path.
 enum class EventCode : uint8_t {
@@ -104,7 +114,11 @@ struct TelemetryRecord {
   bool has_sample = true;
   Sample sample;
   Command command;
-  ControllerTerms controller;
+  ControllerTerms controller;  // the first control channel's
+  // A rig with several control channels (a two-poster): how many, and
+  // those after the first (more_channels[i - 1] is channel i).
+  uint8_t channel_count = 1;
+  std::array<ChannelTerms, kMaxChannels - 1> more_channels{};
   RigState state = RigState::kRunning;
   SafetyState safety_state = SafetyState::kRunning;
   bool valve_enabled = true;  // false: the driver holds its safe command, `command` was not written

@@ -15,6 +15,7 @@
 #include <spdlog/spdlog.h>
 
 #include "rt/comms/event_text.hpp"
+#include "rigctl/channels_t.hpp"
 #include "rigctl/command_t.hpp"
 #include "rigctl/controller_t.hpp"
 #include "rigctl/driver_status_t.hpp"
@@ -111,6 +112,7 @@ TelemetryPublisher::TelemetryPublisher(TelemetryMeta meta, const std::string& lc
   check_size(meta_.layout.inputs.size(), kMaxInputs, "inputs");
   check_size(meta_.layout.outputs.size(), kMaxOutputs, "outputs");
   check_size(meta_.term_names.size(), kMaxControllerTerms, "controller terms");
+  check_size(meta_.more_setpoint_names.size() + 1, kMaxChannels, "control channels");
   // An empty URL would make LCM fall back to its default multicast group:
   // never do that by accident.
   if (lcm_url.empty()) throw std::runtime_error("telemetry: no LCM URL given (e.g. memq:// or udpm://...)");
@@ -294,6 +296,25 @@ void TelemetryPublisher::thread_main() {
   }
 }
 
+// The control channels after the first (a rig with several actuators).
+void TelemetryPublisher::publish_more_channels(const TelemetryRecord& r, int64_t utime, double t) {
+  rigctl::channels_t m;
+  m.utime = utime;
+  m.tick = r.tick;
+  m.t = t;
+  const std::size_t n = meta_.more_setpoint_names.size();
+  m.num_channels = static_cast<int16_t>(n);
+  m.setpoint_names = meta_.more_setpoint_names;
+  for (std::size_t i = 0; i < n; ++i) {
+    const ChannelTerms& c = r.more_channels[i];
+    m.setpoints.push_back(c.setpoint);
+    m.measurements.push_back(c.measurement);
+    m.outputs.push_back(c.output);
+    m.saturated.push_back(c.saturated);
+  }
+  note_log_result(emit(*lcm_, log_.get(), taps_, channels_.channels, utime, m));
+}
+
 void TelemetryPublisher::publish_record(const TelemetryRecord& r) {
   last_t_ns_ = r.sample.t_ns;
   const int64_t utime = meta_.start_utime + r.sample.t_ns / 1000;
@@ -342,6 +363,7 @@ void TelemetryPublisher::publish_record(const TelemetryRecord& r) {
     k.saturated = r.controller.saturated;
     k.integrator_held = r.controller.integrator_held;
     note_log_result(emit(*lcm_, log, taps_, channels_.controller, utime, k));
+    if (!meta_.more_setpoint_names.empty()) publish_more_channels(r, utime, t);
     if (r.procedure.active) publish_procedure(r, utime, t);
   }
 

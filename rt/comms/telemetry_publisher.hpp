@@ -33,7 +33,11 @@ namespace rigctl {
 struct TelemetryMeta {
   std::string rig;                 // "quarter_car"
   ChannelLayout layout;            // names/units of sample inputs and command outputs
-  std::string setpoint_name;       // "x_ref"
+  std::string setpoint_name;       // "x_ref"; with several control channels the first's, "x_ref_1"
+  // The demands of the control channels after the first ("x_ref_2", ...):
+  // published on <prefix>CHANNELS (lcmtypes/rigctl_channels_t.lcm); empty
+  // for a one-channel rig, which publishes no such message.
+  std::vector<std::string> more_setpoint_names;
   std::string controller_name;     // "pi"
   std::vector<std::string> term_names;  // controller terms, e.g. {"p", "i"}
   std::string channel_prefix = "RIGCTL_";
@@ -51,10 +55,11 @@ struct TelemetryMeta {
 
 // LCM channel names, given the prefix.
 struct TelemetryChannels {
-  std::string sample, command, controller, timing, state, driver, procedure;
+  std::string sample, command, controller, timing, state, driver, procedure, channels;
   explicit TelemetryChannels(const std::string& prefix)
       : sample(prefix + "SAMPLE"), command(prefix + "COMMAND"), controller(prefix + "CONTROLLER"),
-        timing(prefix + "TIMING"), state(prefix + "STATE"), driver(prefix + "DRIVER"), procedure(prefix + "PROCEDURE") {}
+        timing(prefix + "TIMING"), state(prefix + "STATE"), driver(prefix + "DRIVER"), procedure(prefix + "PROCEDURE"),
+        channels(prefix + "CHANNELS") {}
 };
 
 class TelemetryPublisher final : public TelemetrySink {
@@ -104,6 +109,7 @@ class TelemetryPublisher final : public TelemetrySink {
   void thread_main();
   void publish_record(const TelemetryRecord& record);
   void publish_procedure(const TelemetryRecord& record, int64_t utime, double t);
+  void publish_more_channels(const TelemetryRecord& record, int64_t utime, double t);
   void publish_driver_status();
   void publish_reports();
   void publish_state_event(const std::string& event, const std::string& message, bool to_log);

@@ -1,5 +1,9 @@
 #include "rt/loop/rig_loop.hpp"
 
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
 namespace rigctl {
 
 namespace {
@@ -30,6 +34,22 @@ RigLoop::RigLoop(Driver& driver, Controller& controller, FilteredProfile& profil
     : driver_(driver), controller_(controller), profile_(profile), detectors_(std::move(detectors)),
       telemetry_(telemetry), clock_(clock), options_(options), safety_(safety),
       machine_(with_period(safety.machine, options.period_ns)), timing_(options.period_ns, options.overrun_policy) {}
+
+void RigLoop::set_more_channels(std::span<const ControlChannel> channels) {
+  if (channels.size() > more_channels_.size()) {
+    throw std::invalid_argument("rig loop: " + std::to_string(channels.size() + 1) + " control channels, at most " +
+                                std::to_string(kMaxChannels));
+  }
+  for (const ControlChannel& c : channels) {
+    if (c.controller == nullptr || c.profile == nullptr || c.feedback_input < 0 ||
+        c.feedback_input >= static_cast<int>(kMaxInputs)) {
+      throw std::invalid_argument("rig loop: a control channel without a controller, profile or feedback input");
+    }
+  }
+  std::copy(channels.begin(), channels.end(), more_channels_.begin());
+  more_count_ = channels.size();
+  machine_.set_channel_count(1 + more_count_);
+}
 
 void RigLoop::set_procedure(ProcedureRunner* procedure, RecoverySink* recovery, int64_t recovery_every_ticks) {
   procedure_ = procedure;
@@ -73,6 +93,10 @@ LoopResult RigLoop::run(const std::atomic<bool>& stop_requested) {
 void RigLoop::begin_run(RunState& run) noexcept {
   controller_.reset();
   profile_.reset();
+  for (std::size_t i = 0; i < more_count_; ++i) {
+    more_channels_[i].controller->reset();
+    more_channels_[i].profile->reset();
+  }
   machine_.power_on();
   commands_.restart(safety_.auto_sequence);
   run.feedback_input = safety_.feedback_input >= 0
@@ -151,6 +175,8 @@ RigLoop::Step RigLoop::step_state_machine(const DetectorResult& trips, RunState&
   in.faults_present = trips.faults_present;
   in.feedback_valid = !trips.feedback_invalid;
   in.feedback = run.record.sample.value[static_cast<std::size_t>(run.feedback_input)];
+  for (std::size_t i = 0; i < more_count_; ++i)
+    in.more_feedback[i] = run.record.sample.value[static_cast<std::size_t>(more_channels_[i].feedback_input)];
   run.feedback = in.feedback;
   events_.begin_tick();
   const SafetyState before = machine_.state();
@@ -206,7 +232,10 @@ void RigLoop::on_accepted(const OperatorCommand& c, EventSource source, const Co
     run.worst_trip = Event{};
   }
   switch (c.kind) {
-    case OperatorCommandKind::kArm: controller_.reset(); break;  // take over the valve with a fresh integrator
+    case OperatorCommandKind::kArm:  // take over the valves with fresh integrators
+      controller_.reset();
+      for (std::size_t i = 0; i < more_count_; ++i) more_channels_[i].controller->reset();
+      break;
     case OperatorCommandKind::kStop:
       if (source == EventSource::kOperator) run.operator_stopped = true;
       break;
@@ -226,6 +255,14 @@ void RigLoop::on_accepted(const OperatorCommand& c, EventSource source, const Co
       run.profile_clock.restart_at(run.t_ns());
       if (options_.start_from_input >= 0) {
         profile_.start_from(run.record.sample.value[static_cast<std::size_t>(options_.start_from_input)]);
+      }
+      for (std::size_t i = 0; i < more_count_; ++i) {
+        FilteredProfile& p = *more_channels_[i].profile;
+        p.reset();
+        // A bumpless start is the rig's choice: every channel from where it stands.
+        if (options_.start_from_input >= 0) {
+          p.start_from(run.record.sample.value[static_cast<std::size_t>(more_channels_[i].feedback_input)]);
+        }
       }
       break;
     default: break;
@@ -256,6 +293,20 @@ void RigLoop::demand(RunState& run) noexcept {
   const bool profile_mode = machine_.demand_mode() == DemandMode::kProfile;
   const double profile = !profile_mode ? 0.0 : procedure_ != nullptr ? procedure_value(run) : profile_value(run);
   run.demand = machine_.next_demand(profile);
+  more_channel_demands(run);
+}
+
+// Every channel after the first: its own profile on the rig's profile clock,
+// shaped by the state machine like the first. A procedure drives only the
+// first channel; the others play their profiles.
+void RigLoop::more_channel_demands(RunState& run) noexcept {
+  if (more_count_ == 0) return;
+  const bool profile_mode = machine_.demand_mode() == DemandMode::kProfile;
+  const double t_profile = run.profile_clock.profile_time_s(run.t_ns());
+  for (std::size_t i = 0; i < more_count_; ++i) {
+    const double profile = profile_mode ? more_channels_[i].profile->next(t_profile) : 0.0;
+    run.more_demand[i] = machine_.next_channel_demand(i + 1, profile);
+  }
 }
 
 double RigLoop::profile_value(RunState& run) noexcept {
@@ -299,6 +350,7 @@ void RigLoop::control_and_write(RunState& run) {
   TelemetryRecord& r = run.record;
   if (run.valve_enabled) {
     controller_.update(run.demand, r.sample, r.command, r.controller);
+    control_more_channels(run);
     stamp(TickStage::kControl);
     driver_.write(r.command);
     stamp(TickStage::kWrite);
@@ -308,6 +360,23 @@ void RigLoop::control_and_write(RunState& run) {
     // it is defined); nothing is written, the record shows no command.
     r.controller.setpoint = run.demand;
     r.controller.measurement = run.feedback;
+    for (std::size_t i = 0; i < more_count_; ++i) {
+      r.more_channels[i].setpoint = run.more_demand[i];
+      r.more_channels[i].measurement = r.sample.value[static_cast<std::size_t>(more_channels_[i].feedback_input)];
+    }
+  }
+}
+
+// Each channel after the first writes its own output of the tick's command.
+void RigLoop::control_more_channels(RunState& run) noexcept {
+  TelemetryRecord& r = run.record;
+  for (std::size_t i = 0; i < more_count_; ++i) {
+    more_channels_[i].controller->update(run.more_demand[i], r.sample, r.command, more_terms_);
+    ChannelTerms& c = r.more_channels[i];
+    c.setpoint = more_terms_.setpoint;
+    c.measurement = more_terms_.measurement;
+    c.output = more_terms_.output;
+    c.saturated = more_terms_.saturated;
   }
 }
 
@@ -318,6 +387,7 @@ void RigLoop::hand_off(RunState& run) noexcept {
   r.state = coarse_state(machine_.state(), run.ever_ran);
   r.safety_state = machine_.state();
   r.valve_enabled = run.valve_enabled;
+  r.channel_count = static_cast<uint8_t>(1 + more_count_);
   r.event = record_event(run);
   if (procedure_ != nullptr) {
     r.procedure = procedure_->status();

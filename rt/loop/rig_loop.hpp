@@ -22,6 +22,7 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <span>
 
 #include "rt/comms/event_sink.hpp"
 #include "rt/comms/telemetry_sink.hpp"
@@ -63,6 +64,17 @@ struct SafetyOptions {
   int feedback_input = -1;  // the controlled input: arm holds here; -1 = input 0
 };
 
+// A control channel after the first of a rig with several actuators (a
+// two-poster road simulator): its own controller (which reads its own
+// feedback input and writes its own output of the shared Command), its own
+// profile, and the input arm holds it at. The limit detectors and the state
+// machine act on the whole rig: one interlock makes every output safe.
+struct ControlChannel {
+  Controller* controller = nullptr;
+  FilteredProfile* profile = nullptr;
+  int feedback_input = 0;
+};
+
 struct LoopResult {
   int64_t ticks = 0;
   RigState final_state = RigState::kStopped;
@@ -89,6 +101,11 @@ class RigLoop {
   // `recovery` (may be nullptr) at every cycle, pass and step end and at
   // least every recovery_every_ticks.
   void set_procedure(ProcedureRunner* procedure, RecoverySink* recovery, int64_t recovery_every_ticks);
+  // The rig's control channels after the first (the constructor's controller
+  // and profile are channel 1), each run every tick after the first; at most
+  // kMaxChannels - 1 (std::invalid_argument otherwise). Copied into a fixed
+  // array: the tick walks it without allocating.
+  void set_more_channels(std::span<const ControlChannel> channels);
 
   // Runs until the rig is stopped (max_ticks or stop_requested: a controlled
   // stop) or faulted (automatic sequence). stop_requested is set from a
@@ -128,6 +145,8 @@ class RigLoop {
   void stop_at_run_length(RunState& run) noexcept;
   void emit(TelemetryRecord& record, bool with_timing) noexcept;
   double procedure_value(RunState& run) noexcept;
+  void more_channel_demands(RunState& run) noexcept;
+  void control_more_channels(RunState& run) noexcept;
   void offer_recovery(RunState& run) noexcept;
 
   Driver& driver_;
@@ -148,6 +167,9 @@ class RigLoop {
   int64_t recovery_every_ticks_ = 0;
   int64_t last_recovery_tick_ = 0;
   std::unique_ptr<ProcedureRecovery> recovery_;  // the hand-off's scratch, allocated before the run
+  std::array<ControlChannel, kMaxChannels - 1> more_channels_{};  // channel i at i - 1
+  std::size_t more_count_ = 0;
+  ControllerTerms more_terms_{};  // scratch for a channel's full terms; the record keeps their brief
 };
 
 }  // namespace rigctl

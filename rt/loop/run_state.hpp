@@ -4,6 +4,7 @@
 // anything that could allocate.
 #pragma once
 
+#include <array>
 #include <cstdint>
 
 #include "rt/telemetry_record.hpp"
@@ -37,6 +38,9 @@ struct RunState {
   double feedback = 0.0;    // the controlled input in this tick's sample
   bool valve_enabled = false;  // the valve is driven this tick (after the commands)
   double demand = 0.0;         // this tick's demand; the previous one while the valve is not driven
+  // The demands of the control channels after the first (channel i's at
+  // i - 1), kept like `demand`: the previous ones while the valve is not driven.
+  std::array<double, kMaxChannels - 1> more_demand{};
   Event command_event{};       // this tick's operator or signal command, accepted or refused: the record shows it
   Event procedure_trip{};      // this tick's new trip of the test procedure (peak-valley change, compensation limit)
 

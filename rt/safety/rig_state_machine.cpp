@@ -150,7 +150,25 @@ double DemandShaper::next_profile(double profile) noexcept {
 
 RigStateMachine::RigStateMachine(const StateMachineConfig& config) : config_(config) {
   shaper_.configure(config.period_s, config.hold_deceleration, config.setpoint_rate);
+  for (auto& m : more_shapers_) m.configure(config.period_s, config.hold_deceleration, config.setpoint_rate);
   power_on();
+}
+
+void RigStateMachine::set_channel_count(std::size_t n) noexcept {
+  channel_count_ = n < 1 ? 1 : n > kMaxChannels ? kMaxChannels : n;
+}
+
+bool RigStateMachine::all_settled() const noexcept {
+  if (!shaper_.settled()) return false;
+  for (std::size_t i = 1; i < channel_count_; ++i)
+    if (!more_shapers_[i - 1].settled()) return false;
+  return true;
+}
+
+double RigStateMachine::next_channel_demand(std::size_t channel, double profile) noexcept {
+  if (channel == 0) return next_demand(profile);
+  DemandShaper& s = more_shapers_[channel - 1];
+  return demand_mode() == DemandMode::kProfile ? s.next_profile(profile) : s.next_hold();
 }
 
 void RigStateMachine::power_on() noexcept {
@@ -200,7 +218,7 @@ void RigStateMachine::enter(SafetyState to, EventCode cause) noexcept {
 }
 
 void RigStateMachine::settle_stop() noexcept {
-  if (state_ == S::kStopping && shaper_.settled()) enter(S::kHydraulicsHigh, EventCode::kNone);
+  if (state_ == S::kStopping && all_settled()) enter(S::kHydraulicsHigh, EventCode::kNone);
 }
 
 void RigStateMachine::begin_tick(const MachineInputs& in, EventCode trip_cause) noexcept {
@@ -216,11 +234,11 @@ void RigStateMachine::begin_tick(const MachineInputs& in, EventCode trip_cause) 
     } else if (in.limit_action == LimitAction::kStop &&
                (state_ == S::kArmed || state_ == S::kRunning || state_ == S::kHolding)) {
       stop_by_trip_ = true;
-      shaper_.ramp_to_hold();
+      each_shaper([](DemandShaper& d, double) { d.ramp_to_hold(); });
       enter(S::kStopping, trip_cause);
       settle_stop();
     } else if (in.limit_action == LimitAction::kHold && state_ == S::kRunning) {
-      shaper_.ramp_to_hold();
+      each_shaper([](DemandShaper& d, double) { d.ramp_to_hold(); });
       enter(S::kHolding, trip_cause);
     }
   }
@@ -279,13 +297,13 @@ CommandResult RigStateMachine::apply(const OperatorCommand& command) noexcept {
       result.reset_latches = true;
       stop_by_trip_ = false;
       break;
-    case OperatorCommandKind::kArm: shaper_.hold_at(in_.feedback); break;
+    case OperatorCommandKind::kArm: each_shaper([](DemandShaper& d, double at) { d.hold_at(at); }); break;
     case OperatorCommandKind::kStart:
-    case OperatorCommandKind::kResume: shaper_.enter_profile(); break;
-    case OperatorCommandKind::kHold: shaper_.ramp_to_hold(); break;
+    case OperatorCommandKind::kResume: each_shaper([](DemandShaper& d, double) { d.enter_profile(); }); break;
+    case OperatorCommandKind::kHold: each_shaper([](DemandShaper& d, double) { d.ramp_to_hold(); }); break;
     case OperatorCommandKind::kStop:
       stop_by_trip_ = false;
-      if (from != S::kArmed) shaper_.ramp_to_hold();
+      if (from != S::kArmed) each_shaper([](DemandShaper& d, double) { d.ramp_to_hold(); });
       break;
     case OperatorCommandKind::kSetpoint: shaper_.set_target(command.value); break;
     default: break;
@@ -301,7 +319,7 @@ double RigStateMachine::next_demand(double profile) noexcept {
 
 void RigStateMachine::profile_finished() noexcept {
   if (state_ != S::kRunning) return;
-  shaper_.ramp_to_hold();
+  each_shaper([](DemandShaper& d, double) { d.ramp_to_hold(); });
   enter(S::kHolding, EventCode::kProfileFinished);
 }
 

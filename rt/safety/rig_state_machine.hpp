@@ -118,6 +118,10 @@ struct MachineInputs {
   bool faults_present = false;  // a detector condition is active now (reset would fail)
   bool feedback_valid = true;
   double feedback = 0.0;        // the controlled position, SI
+  // A rig with several control channels: the controlled position of each
+  // channel after the first (more_feedback[i - 1] is channel i's); arm holds
+  // every channel where it stands.
+  std::array<double, kMaxChannels - 1> more_feedback{};
   // Pressure switches where the rig has them; -1: not wired, use the settle time.
   int8_t low_pressure_reached = -1;
   int8_t high_pressure_reached = -1;
@@ -199,6 +203,16 @@ class RigStateMachine {
   double next_demand(double profile) noexcept;
   const DemandShaper& shaper() const noexcept { return shaper_; }
 
+  // Several control channels (1 by default, at most kMaxChannels): every
+  // channel's demand is shaped alike (arm holds it where it stands, a hold
+  // or stop brakes it, start removes its offset to the profile); a setpoint
+  // command moves only the first channel's. A stop settles when every
+  // channel's demand is at rest. Set before power_on.
+  void set_channel_count(std::size_t n) noexcept;
+  std::size_t channel_count() const noexcept { return channel_count_; }
+  // The demand of channel i >= 1 for this tick, like next_demand.
+  double next_channel_demand(std::size_t channel, double profile) noexcept;
+
   // The profile ended while running (operator mode): ramp to a hold.
   void profile_finished() noexcept;
 
@@ -225,7 +239,16 @@ class RigStateMachine {
   double stage_elapsed_s_ = 0.0;
   double stopping_elapsed_s_ = 0.0;
   bool stop_by_trip_ = false;
-  DemandShaper shaper_;
+  DemandShaper shaper_;  // the first channel's
+  std::array<DemandShaper, kMaxChannels - 1> more_shapers_{};  // channel i's at i - 1
+  std::size_t channel_count_ = 1;
+  // Every shaper of the rig's channels, the first one's first.
+  template <class F>
+  void each_shaper(F&& f) noexcept {
+    f(shaper_, in_.feedback);
+    for (std::size_t i = 1; i < channel_count_; ++i) f(more_shapers_[i - 1], in_.more_feedback[i - 1]);
+  }
+  bool all_settled() const noexcept;
   std::array<StateChange, 8> changes_{};
   std::size_t change_count_ = 0;
 };

@@ -119,7 +119,7 @@ TEST_F(CliTest, BadConfigIsAClearErrorAndNothingRuns) {
 TEST_F(CliTest, UnknownRigKindOnTheCommandLineListsTheKnownKinds) {
   const auto make = run_command(kRigctl + " make-run --rig bicycle --out " + path("m.csv"));
   EXPECT_EQ(make.exit_code, 1) << make.output;
-  EXPECT_NE(make.output.find("unknown rig kind 'bicycle' (known: quarter_car, pneumatic_rotary, half_car)"),
+  EXPECT_NE(make.output.find("unknown rig kind 'bicycle' (known: quarter_car, pneumatic_rotary, half_car, two_poster)"),
             std::string::npos)
       << make.output;
   EXPECT_FALSE(fs::exists(path("m.csv")));

@@ -52,6 +52,7 @@ Section io_section();         // tools/bench/io.cpp
 Section diagnosis_section();  // tools/bench/diagnosis.cpp
 Section diagnosis_sweep_section();  // tools/bench/diagnosis.cpp
 Section scaling_section();    // tools/bench/scaling.cpp
+Section channels_section();   // tools/bench/channels.cpp
 Section foxglove_section();   // tools/bench/foxglove.cpp
 Section foxglove_limits_section();  // tools/bench/foxglove_limits.cpp
 

@@ -83,8 +83,10 @@ SweepResult run_sweep(const SweepOptions& o, const std::atomic<bool>& stop, std:
         std::ostringstream quiet;
         make_run(mr, quiet);
         const auto d_start = std::chrono::steady_clock::now();
-        const auto rf = read_run_file(mr.out_csv, run_file_columns(run_file_rig(rig)));
-        const auto model = diag::make_rig_model(run_file_rig(rig), rf, {});
+        const auto file_rig = run_file_rig(rig);
+        if (!file_rig) throw std::runtime_error("the diagnosis has no model of the " + o.rig + " rig");
+        const auto rf = read_run_file(mr.out_csv, run_file_columns(*file_rig));
+        const auto model = diag::make_rig_model(*file_rig, rf, {});
         const auto d = diag::diagnose(*model, {});
         cell.diagnose_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - d_start).count();
         cell.named = d.cause;

@@ -27,6 +27,7 @@ const RigEffectGenerator& effect_generator(RigKind rig) {
     case RigKind::kQuarterCar: return quarter_car_effect_generator();
     case RigKind::kPneumaticRotary: return pneumatic_rotary_effect_generator();
     case RigKind::kHalfCar: return half_car_effect_generator();
+    case RigKind::kTwoPoster: throw std::invalid_argument("make-run: no hidden effects for the two_poster rig yet");
   }
   throw std::logic_error("effect_generator: rig kind out of range");
 }

@@ -149,7 +149,8 @@ std::vector<FrfCurve> linearised_plant_frf(const RigConfig& config, double opera
     // elements with no derivative at rest, and the half car is not a
     // position loop: no linearisation to compare with.
     case RigKind::kPneumaticRotary:
-    case RigKind::kHalfCar: return {};
+    case RigKind::kHalfCar:
+    case RigKind::kTwoPoster: return {};  // two drives: its linearisation is the MIMO one (tools/identify/mimo_*)
   }
   return {};
 }

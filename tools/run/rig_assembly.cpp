@@ -1,5 +1,6 @@
 #include "tools/run/rig_assembly.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "config/config_reader.hpp"
@@ -8,6 +9,7 @@
 #include "plant/half_car/half_car_plant.hpp"
 #include "plant/pneumatic_rotary/pneumatic_rotary_plant.hpp"
 #include "plant/quarter_car/quarter_car_plant.hpp"
+#include "plant/two_poster/two_poster_plant.hpp"
 #include "rt/control/fuzzy_suspension_controller.hpp"
 #include "rt/control/lqr_controller.hpp"
 #include "rt/control/pi_controller.hpp"
@@ -72,6 +74,7 @@ std::unique_ptr<SimulatedPlant> make_plant(const RigConfig& c) {
     case RigKind::kQuarterCar: return std::make_unique<QuarterCarPlant>(c.quarter_car);
     case RigKind::kPneumaticRotary: return std::make_unique<PneumaticRotaryPlant>(c.pneumatic_rotary);
     case RigKind::kHalfCar: return std::make_unique<HalfCarPlant>(c.half_car);
+    case RigKind::kTwoPoster: return std::make_unique<TwoPosterPlant>(c.two_poster);
   }
   throw std::logic_error("make_plant: rig kind out of range");
 }
@@ -343,9 +346,36 @@ std::string setpoint_name_for(RigKind rig) {
     case RigKind::kQuarterCar: return "x_ref";
     case RigKind::kPneumaticRotary: return "theta_d";
     case RigKind::kHalfCar: return "z_s_ref";  // body heave demand (0: hold the body at rest)
+    case RigKind::kTwoPoster: return "x_ref";  // each post's platen demand: x_ref_1, x_ref_2
   }
   return "setpoint";
 }
+
+namespace {
+
+// Channel i >= 1 of `channels:`: its controller and profile, built by the
+// one-channel code from a copy of the config with this channel's sections,
+// errors naming channels[i].
+void assemble_more_channels(const RigConfig& c, const ChannelLayout& layout, AssembledRig& rig) {
+  for (std::size_t i = 0; i < c.more_channels.size(); ++i) {
+    RigConfig one = c;
+    one.controller = c.more_channels[i].controller;
+    one.profile = c.more_channels[i].profile;
+    one.file = c.file + ": channels[" + std::to_string(i + 1) + "]";
+    rig.more_controllers.push_back(make_controller(one, layout));
+    double duration = 0.0;
+    rig.more_profiles.push_back(make_profile(one, duration));
+    rig.profile_duration_s = std::max(rig.profile_duration_s, duration);
+    ControlChannel ch;
+    ch.controller = rig.more_controllers.back().get();
+    ch.profile = rig.more_profiles.back().get();
+    ch.feedback_input = required_input(one, layout, "controller.feedback", one.controller.feedback);
+    rig.more_channels.push_back(ch);
+    rig.more_setpoint_names.push_back(setpoint_name_for(c.rig) + "_" + std::to_string(i + 2));
+  }
+}
+
+}  // namespace
 
 AssembledRig assemble_rig(const RigConfig& c) {
   AssembledRig rig;
@@ -360,6 +390,10 @@ AssembledRig assemble_rig(const RigConfig& c) {
   rig.profile = make_profile(c, rig.profile_duration_s);
   rig.setpoint_name = setpoint_name_for(c.rig);
   if (c.profile.start_from_measurement) rig.profile_start_input = layout.input_index(c.controller.feedback);
+  if (!c.more_channels.empty()) {
+    rig.setpoint_name += "_1";
+    assemble_more_channels(c, layout, rig);
+  }
   return rig;
 }
 

@@ -6,6 +6,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "config/rig_config.hpp"
 #include "rt/driver.hpp"
@@ -23,7 +24,13 @@ struct AssembledRig {
   std::unique_ptr<FilteredProfile> profile;
   LimitDetectors detectors;   // every input's plausibility, `limits:` and `safety.detectors`
   SafetyOptions safety;       // the state machine's settings from `safety:`
-  std::string setpoint_name;  // run-file column of the demand, e.g. "x_ref"
+  std::string setpoint_name;  // run-file column of the demand, e.g. "x_ref"; "x_ref_1" with several channels
+  // The control channels after the first (`channels:`): their controllers,
+  // profiles, the loop's view of them and their demands' column names.
+  std::vector<std::unique_ptr<Controller>> more_controllers;
+  std::vector<std::unique_ptr<FilteredProfile>> more_profiles;
+  std::vector<ControlChannel> more_channels;
+  std::vector<std::string> more_setpoint_names;  // "x_ref_2", ...
   double profile_duration_s = 0.0;
   int profile_start_input = -1;  // the feedback input the profile starts from, -1: the configured start
 };

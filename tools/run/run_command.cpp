@@ -154,6 +154,7 @@ TelemetryMeta telemetry_meta_for(const RigConfig& config, const AssembledRig& ri
   meta.rig = to_string(config.rig);
   meta.layout = rig.driver->layout();
   meta.setpoint_name = rig.setpoint_name;
+  meta.more_setpoint_names = rig.more_setpoint_names;
   meta.controller_name = rig.controller->name();
   meta.term_names = rig.controller->term_names();
   meta.channel_prefix = config.telemetry.channel_prefix;
@@ -385,6 +386,7 @@ RunReport run_rig(const RigConfig& config_file, const RunOptions& options, const
     }
     RigLoop loop(*rig.driver, *rig.controller, *rig.profile, rig.detectors, heartbeat, clock, loop_options,
                  rig.safety);
+    loop.set_more_channels(rig.more_channels);
     loop.set_event_sink(&events);
     loop.set_operator_commands(commands);
     if (procedure) loop.set_procedure(procedure->runner.get(), procedure->writer.get(), procedure->recovery_every_ticks);

@@ -1,7 +1,9 @@
 // LCM log -> run-file CSV (docs/run-files.md). Two passes over the
 // log: the first finds the layout and the sample rate (the metadata lines come
 // before the data), the second joins SAMPLE and COMMAND by tick and writes
-// rows, holding only a short window of ticks in memory.
+// rows, holding only a short window of ticks in memory. A rig with several
+// control channels also logs CHANNELS (the demands after the first): its
+// setpoints follow the first one's column (x_ref_1, x_ref_2, ..., u_1, u_2, ...).
 #include "tools/runfile/log2csv.hpp"
 
 #include <algorithm>
@@ -19,6 +21,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "rigctl/channels_t.hpp"
 #include "rigctl/command_t.hpp"
 #include "rigctl/sample_t.hpp"
 #include "rigctl/timing_t.hpp"
@@ -57,6 +60,7 @@ struct Layout {
   std::vector<std::string> inputs;
   std::vector<bool> keep_input;  // written to the file (simulator truth channels may be left out)
   std::vector<std::string> outputs;
+  std::vector<std::string> more_setpoints;  // the CHANNELS message's, empty for a one-channel rig
   // The file's columns after t, as every telemetry writer names them.
   std::vector<TelemetryColumn> command_columns, input_columns;
   long sample_rate_hz = 0;  // 0 = unknown (fewer than two samples)
@@ -81,10 +85,11 @@ long median_rate(std::vector<std::pair<int64_t, double>> tick_t) {
 }
 
 Layout scan(const std::string& path, const std::string& sample_ch, const std::string& command_ch,
-            const std::string& timing_ch) {
+            const std::string& timing_ch, const std::string& channels_ch) {
   Layout layout;
   bool have_sample = false;
   bool have_command = false;
+  bool have_channels = false;
   std::vector<std::pair<int64_t, double>> tick_t;
   for_each_event(path, [&](const lcm::LogEvent& ev) {
     if (ev.channel == sample_ch) {
@@ -103,6 +108,11 @@ Layout scan(const std::string& path, const std::string& sample_ch, const std::st
       layout.command_columns = command_columns(c);
       layout.outputs = c.names;
       have_command = true;
+    } else if (ev.channel == channels_ch && !have_channels) {
+      rigctl::channels_t m;
+      if (!decode(ev, m)) return;
+      layout.more_setpoints = m.setpoint_names;
+      have_channels = true;
     } else if (ev.channel == timing_ch) {
       rigctl::timing_t m;
       if (!decode(ev, m)) return;
@@ -113,17 +123,24 @@ Layout scan(const std::string& path, const std::string& sample_ch, const std::st
   if (!have_sample) fail(path, "no sample messages on channel " + sample_ch);
   if (!have_command) fail(path, "no command messages on channel " + command_ch);
   layout.sample_rate_hz = median_rate(std::move(tick_t));
+  // The demands of the channels after the first, after the first's column.
+  std::vector<TelemetryColumn> more;
+  for (const auto& name : layout.more_setpoints) more.push_back({name, ""});
+  layout.command_columns.insert(layout.command_columns.begin() + 1, more.begin(), more.end());
   return layout;
 }
 
 struct Pending {
   bool has_sample = false;
   bool has_command = false;
+  bool has_channels = false;
   double t = 0.0;
   int32_t status = 0;
   std::vector<std::string> in_names, out_names;
   std::vector<double> in, out;
   double setpoint = 0.0;
+  std::vector<std::string> more_setpoint_names;
+  std::vector<double> more_setpoints;
 };
 
 // Writes the rows in tick order; drops what the run-file contract forbids.
@@ -132,7 +149,10 @@ class RowWriter {
   RowWriter(std::FILE* f, const Layout& layout) : f_(f), layout_(layout) {}
 
   void write(const Pending& p, Log2CsvResult& result) {
-    if (!p.has_sample || !p.has_command || p.in_names != layout_.inputs || p.out_names != layout_.outputs) {
+    const bool channels_ok = layout_.more_setpoints.empty() ||
+                             (p.has_channels && p.more_setpoint_names == layout_.more_setpoints);
+    if (!p.has_sample || !p.has_command || !channels_ok || p.in_names != layout_.inputs ||
+        p.out_names != layout_.outputs) {
       ++result.skipped;
       return;
     }
@@ -140,6 +160,7 @@ class RowWriter {
     // number in the file: the diagnosis would take it at face value.
     bool finite = std::isfinite(p.t) && std::isfinite(p.setpoint) && p.status == 0;
     for (double v : p.in) finite = finite && std::isfinite(v);
+    for (double v : p.more_setpoints) finite = finite && std::isfinite(v);
     for (double v : p.out) finite = finite && std::isfinite(v);
     // Compare t as printed, so the file's t column strictly increases.
     char t_text[40];
@@ -153,6 +174,7 @@ class RowWriter {
     last_t_ = t_printed;
     std::fputs(t_text, f_);
     put(p.setpoint);
+    for (double v : p.more_setpoints) put(v);
     for (double v : p.out) put(v);
     for (std::size_t i = 0; i < p.in.size(); ++i)
       if (layout_.keep_input[i]) put(p.in[i]);
@@ -186,7 +208,7 @@ void write_head(std::FILE* f, const Layout& layout, const std::string& log_path)
 }
 
 void join_and_write(const std::string& path, const std::string& sample_ch, const std::string& command_ch,
-                    RowWriter& writer, Log2CsvResult& result) {
+                    const std::string& channels_ch, RowWriter& writer, Log2CsvResult& result) {
   std::map<int64_t, Pending> pending;
   int64_t max_tick = std::numeric_limits<int64_t>::min();
   int64_t last_written = std::numeric_limits<int64_t>::min();
@@ -215,6 +237,14 @@ void join_and_write(const std::string& path, const std::string& sample_ch, const
       p->setpoint = c.setpoint;
       p->out_names = std::move(c.names);
       p->out = std::move(c.values);
+    } else if (ev.channel == channels_ch) {
+      rigctl::channels_t m;
+      if (!decode(ev, m)) return;
+      Pending* p = slot(m.tick);
+      if (p == nullptr) return;
+      p->has_channels = true;
+      p->more_setpoint_names = std::move(m.setpoint_names);
+      p->more_setpoints = std::move(m.setpoints);
     } else {
       return;
     }
@@ -245,7 +275,8 @@ Log2CsvResult log_to_csv(const std::string& lcm_log_path, const std::string& csv
   const std::string sample_ch = channel_prefix + "SAMPLE";
   const std::string command_ch = channel_prefix + "COMMAND";
   check_is_lcm_log(lcm_log_path, "log2csv");
-  Layout layout = scan(lcm_log_path, sample_ch, command_ch, channel_prefix + "TIMING");
+  const std::string channels_ch = channel_prefix + "CHANNELS";
+  Layout layout = scan(lcm_log_path, sample_ch, command_ch, channel_prefix + "TIMING", channels_ch);
   for (const auto& name : layout.inputs) layout.keep_input.push_back(simulator_truth || name.rfind("sim_", 0) != 0);
 
   TempFile tmp;
@@ -258,7 +289,7 @@ Log2CsvResult log_to_csv(const std::string& lcm_log_path, const std::string& csv
   result.dropped_records = layout.dropped_records;
   write_head(tmp.f, layout, lcm_log_path);
   RowWriter writer(tmp.f, layout);
-  join_and_write(lcm_log_path, sample_ch, command_ch, writer, result);
+  join_and_write(lcm_log_path, sample_ch, command_ch, channels_ch, writer, result);
 
   const bool write_error = std::ferror(tmp.f) != 0;
   const bool close_error = std::fclose(tmp.f) != 0;
