@@ -49,6 +49,103 @@ int integer(const std::string& spec, const std::string& text, const char* what) 
   return static_cast<int>(v);
 }
 
+// A fault's arguments after KIND@: the time, then ARG... .
+struct FaultArgs {
+  const std::string& spec;
+  std::vector<std::string> args;
+  // The count of ARGs after the time, else the usage.
+  void need(std::size_t min, std::size_t max, const char* usage) const {
+    if (args.size() - 1 < min || args.size() - 1 > max) bad(spec, std::string("expected ") + usage);
+  }
+};
+
+// The faults on the wire (rig-sim's Modbus DAQ and CANopen valve; stuck and
+// rail in the process too); false: not one of them.
+bool read_wire_fault(const std::string& kind, const FaultArgs& a, FaultSpec& f) {
+  if (kind == "silence") {
+    f.kind = FaultKind::kSilence;
+    a.need(0, 1, "silence@TIME[:DURATION]");
+    if (a.args.size() > 1) f.duration_s = seconds(a.spec, a.args[1], "duration");
+  } else if (kind == "drop") {
+    f.kind = FaultKind::kDrop;
+    a.need(0, 0, "drop@TIME");
+  } else if (kind == "late") {
+    f.kind = FaultKind::kLate;
+    a.need(1, 2, "late@TIME:DELAY[:DURATION]");
+    f.delay_s = seconds(a.spec, a.args[1], "delay");
+    if (a.args.size() > 2) f.duration_s = seconds(a.spec, a.args[2], "duration");
+  } else if (kind == "exception") {
+    f.kind = FaultKind::kException;
+    a.need(2, 2, "exception@TIME:CHANNEL:CODE");
+    f.channel = a.args[1];
+    f.code = integer(a.spec, a.args[2], "exception code");
+    if (f.code < 1 || f.code > 0xFF) bad(a.spec, "exception code must be 1..255");
+  } else if (kind == "stuck" || kind == "rail") {
+    f.kind = kind == "stuck" ? FaultKind::kStuck : FaultKind::kRail;
+    a.need(1, 1, "stuck@TIME:CHANNEL or rail@TIME:CHANNEL");
+    f.channel = a.args[1];
+  } else if (kind == "heartbeat") {
+    f.kind = FaultKind::kHeartbeat;
+    a.need(1, 1, "heartbeat@TIME:DURATION");
+    f.duration_s = seconds(a.spec, a.args[1], "duration");
+  } else if (kind == "hold") {
+    f.kind = FaultKind::kHold;
+    a.need(1, 1, "hold@TIME:DURATION");
+    f.duration_s = seconds(a.spec, a.args[1], "duration");
+  } else if (kind == "emcy") {
+    f.kind = FaultKind::kEmcy;
+    a.need(2, 2, "emcy@TIME:CODE:ERROR_REGISTER");
+    f.code = integer(a.spec, a.args[1], "EMCY code");
+    f.error_register = integer(a.spec, a.args[2], "error register");
+    if (f.error_register > 0xFF) bad(a.spec, "error register must be 0..255");
+  } else {
+    return false;
+  }
+  return true;
+}
+
+// The faults only the simulated driver injects; false: not one of them.
+bool read_process_fault(const std::string& kind, const FaultArgs& a, FaultSpec& f) {
+  if (kind == "noise") {
+    f.kind = FaultKind::kNoise;
+    a.need(2, 3, "noise@TIME:CHANNEL:SD[:DURATION]");
+    f.channel = a.args[1];
+    f.value = number(a.spec, a.args[2], "noise SD", 0.0);
+    if (a.args.size() > 3) f.duration_s = seconds(a.spec, a.args[3], "duration");
+  } else if (kind == "nan") {
+    f.kind = FaultKind::kNan;
+    a.need(1, 2, "nan@TIME:CHANNEL[:DURATION]");
+    f.channel = a.args[1];
+    if (a.args.size() > 2) f.duration_s = seconds(a.spec, a.args[2], "duration");
+  } else if (kind == "offset") {
+    f.kind = FaultKind::kOffset;
+    a.need(2, 2, "offset@TIME:CHANNEL:OFFSET");
+    f.channel = a.args[1];
+    f.value = number(a.spec, a.args[2], "offset", -1e308);
+  } else if (kind == "overrun") {
+    f.kind = FaultKind::kOverrun;
+    a.need(1, 2, "overrun@TIME:COUNT[:STALL_PERIODS]");
+    f.count = integer(a.spec, a.args[1], "count");
+    f.stall_periods = a.args.size() > 2 ? integer(a.spec, a.args[2], "stall periods") : 2;
+    if (f.count < 1) bad(a.spec, "count must be at least 1");
+    if (f.stall_periods < 1 || f.stall_periods > 400) bad(a.spec, "stall periods must be 1..400");
+  } else if (kind == "supply") {
+    f.kind = FaultKind::kSupply;
+    a.need(1, 1, "supply@TIME:PRESSURE_PA");
+    f.value = number(a.spec, a.args[1], "supply pressure", 0.0);
+  } else if (kind == "burst") {
+    f.kind = FaultKind::kBurst;
+    a.need(1, 2, "burst@TIME:p1|p2[:K]");
+    f.channel = a.args[1];
+    if (f.channel != "p1" && f.channel != "p2") bad(a.spec, "chamber '" + f.channel + "' is not p1 or p2");
+    // About 5.6 times the quarter car's rated valve: 100 l/min at 30 bar.
+    f.value = a.args.size() > 2 ? number(a.spec, a.args[2], "orifice coefficient", 0.0) : 1e-6;
+  } else {
+    return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 bool fault_on_wire(FaultKind kind) {
@@ -72,84 +169,11 @@ FaultSpec parse_fault_spec(const std::string& spec) {
   const auto at = spec.find('@');
   if (at == std::string::npos) bad(spec, "expected KIND@TIME[:ARG...]");
   const std::string kind = spec.substr(0, at);
-  const auto args = split(spec.substr(at + 1), ':');
+  const FaultArgs a{spec, split(spec.substr(at + 1), ':')};
   FaultSpec f;
   f.text = spec;
-  f.at_s = seconds(spec, args.at(0), "time");
-  const auto need = [&](std::size_t min, std::size_t max, const char* usage) {
-    if (args.size() - 1 < min || args.size() - 1 > max) bad(spec, std::string("expected ") + usage);
-  };
-  if (kind == "silence") {
-    f.kind = FaultKind::kSilence;
-    need(0, 1, "silence@TIME[:DURATION]");
-    if (args.size() > 1) f.duration_s = seconds(spec, args[1], "duration");
-  } else if (kind == "drop") {
-    f.kind = FaultKind::kDrop;
-    need(0, 0, "drop@TIME");
-  } else if (kind == "late") {
-    f.kind = FaultKind::kLate;
-    need(1, 2, "late@TIME:DELAY[:DURATION]");
-    f.delay_s = seconds(spec, args[1], "delay");
-    if (args.size() > 2) f.duration_s = seconds(spec, args[2], "duration");
-  } else if (kind == "exception") {
-    f.kind = FaultKind::kException;
-    need(2, 2, "exception@TIME:CHANNEL:CODE");
-    f.channel = args[1];
-    f.code = integer(spec, args[2], "exception code");
-    if (f.code < 1 || f.code > 0xFF) bad(spec, "exception code must be 1..255");
-  } else if (kind == "stuck" || kind == "rail") {
-    f.kind = kind == "stuck" ? FaultKind::kStuck : FaultKind::kRail;
-    need(1, 1, "stuck@TIME:CHANNEL or rail@TIME:CHANNEL");
-    f.channel = args[1];
-  } else if (kind == "heartbeat") {
-    f.kind = FaultKind::kHeartbeat;
-    need(1, 1, "heartbeat@TIME:DURATION");
-    f.duration_s = seconds(spec, args[1], "duration");
-  } else if (kind == "hold") {
-    f.kind = FaultKind::kHold;
-    need(1, 1, "hold@TIME:DURATION");
-    f.duration_s = seconds(spec, args[1], "duration");
-  } else if (kind == "emcy") {
-    f.kind = FaultKind::kEmcy;
-    need(2, 2, "emcy@TIME:CODE:ERROR_REGISTER");
-    f.code = integer(spec, args[1], "EMCY code");
-    f.error_register = integer(spec, args[2], "error register");
-    if (f.error_register > 0xFF) bad(spec, "error register must be 0..255");
-  } else if (kind == "noise") {
-    f.kind = FaultKind::kNoise;
-    need(2, 3, "noise@TIME:CHANNEL:SD[:DURATION]");
-    f.channel = args[1];
-    f.value = number(spec, args[2], "noise SD", 0.0);
-    if (args.size() > 3) f.duration_s = seconds(spec, args[3], "duration");
-  } else if (kind == "nan") {
-    f.kind = FaultKind::kNan;
-    need(1, 2, "nan@TIME:CHANNEL[:DURATION]");
-    f.channel = args[1];
-    if (args.size() > 2) f.duration_s = seconds(spec, args[2], "duration");
-  } else if (kind == "offset") {
-    f.kind = FaultKind::kOffset;
-    need(2, 2, "offset@TIME:CHANNEL:OFFSET");
-    f.channel = args[1];
-    f.value = number(spec, args[2], "offset", -1e308);
-  } else if (kind == "overrun") {
-    f.kind = FaultKind::kOverrun;
-    need(1, 2, "overrun@TIME:COUNT[:STALL_PERIODS]");
-    f.count = integer(spec, args[1], "count");
-    f.stall_periods = args.size() > 2 ? integer(spec, args[2], "stall periods") : 2;
-    if (f.count < 1) bad(spec, "count must be at least 1");
-    if (f.stall_periods < 1 || f.stall_periods > 400) bad(spec, "stall periods must be 1..400");
-  } else if (kind == "supply") {
-    f.kind = FaultKind::kSupply;
-    need(1, 1, "supply@TIME:PRESSURE_PA");
-    f.value = number(spec, args[1], "supply pressure", 0.0);
-  } else if (kind == "burst") {
-    f.kind = FaultKind::kBurst;
-    need(1, 2, "burst@TIME:p1|p2[:K]");
-    f.channel = args[1];
-    if (f.channel != "p1" && f.channel != "p2") bad(spec, "chamber '" + f.channel + "' is not p1 or p2");
-    // About 5.6 times the quarter car's rated valve: 100 l/min at 30 bar.
-    f.value = args.size() > 2 ? number(spec, args[2], "orifice coefficient", 0.0) : 1e-6;
-  } else {
+  f.at_s = seconds(spec, a.args.at(0), "time");
+  if (!read_wire_fault(kind, a, f) && !read_process_fault(kind, a, f)) {
     bad(spec, "unknown kind '" + kind +
                   "' (silence, drop, late, exception, stuck, rail, heartbeat, emcy, hold, noise, nan, offset, overrun, "
                   "supply, burst)");

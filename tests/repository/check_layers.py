@@ -28,6 +28,7 @@ LAYER_OF_FOLDER = {
     'tools/bridge': 'run',
     'tools/catalog': 'run',  # the run catalog: `rigctl run` enters its runs (docs/rig-health.md)
     'tools/procedure': 'run',
+    'tools/cli': 'run',  # the subcommands' interface (tools/cli/subcommand.hpp): every tool folder defines its own
     'tools/hidden_effects': 'hidden_effects',
     'tools/diagnosis': 'diagnosis',
     'tools/health': 'health',  # windows of long runs, trends, change detection, make-series

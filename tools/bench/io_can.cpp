@@ -16,6 +16,89 @@ namespace rigctl::bench::io {
 
 namespace {
 
+// The frames echoed through CanTransport at both ends. `pin` holds the
+// calling thread on the server's CPU (the echo thread starts there) and is
+// moved to the client's for the sender.
+void transport_round_trips(Context& ctx, int64_t frames, int64_t period_ns, int64_t& lost, const Placement& where,
+                           std::optional<PinnedScope>& pin, DurationHistogram& hist) {
+  auto ends = socketpair_seqpacket();
+  CanTransport& a = ends.first;
+  CanTransport& b = ends.second;
+  std::thread echo([&b] {
+    canopen::CanFrame f;
+    for (;;) {
+      const auto rx = b.receive(f, 200);
+      if (rx == CanTransport::Rx::kFrame) {
+        b.send(f);
+      } else if (rx != CanTransport::Rx::kTimeout) {
+        return;
+      }
+    }
+  });
+  pin.emplace(where.client_cpu);  // and the sender runs here
+  int64_t next = mono_ns();
+  for (int64_t k = 0; k < frames && !ctx.stop.load(); ++k) {
+    canopen::CanFrame f = canopen::make_frame(0x201, {0x0f, 0x00, static_cast<uint8_t>(k), static_cast<uint8_t>(k >> 8)});
+    canopen::CanFrame g;
+    const int64_t t0 = mono_ns();
+    a.send(f);
+    if (a.receive(g, 100) == CanTransport::Rx::kFrame && g.data[2] == f.data[2]) {
+      hist.record(mono_ns() - t0);
+    } else {
+      ++lost;
+    }
+    next += period_ns;
+    sleep_until_ns(next);
+  }
+  a.shutdown();
+  echo.join();
+}
+
+// The same frames by bare send/poll/recv on a socketpair: the floor.
+void bare_round_trips(Context& ctx, int64_t frames, int64_t period_ns, int64_t& lost, const Placement& where,
+                      std::optional<PinnedScope>& pin, DurationHistogram& hist) {
+  int sv[2];
+  if (::socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, sv) != 0) {
+    throw std::runtime_error(std::string("socketpair: ") + std::strerror(errno));
+  }
+  std::thread echo([fd = sv[1]] {
+    canopen::CanFrame f;
+    pollfd p{fd, POLLIN, 0};
+    for (;;) {
+      p.revents = 0;
+      const int rc = ::poll(&p, 1, 200);
+      if (rc < 0 && errno == EINTR) continue;
+      if (rc == 0) continue;
+      if (rc < 0 || (p.revents & (POLLHUP | POLLERR)) != 0) return;
+      const ssize_t n = ::recv(fd, &f, sizeof f, 0);
+      if (n <= 0) return;
+      ::send(fd, &f, sizeof f, MSG_DONTWAIT | MSG_NOSIGNAL);
+    }
+  });
+  pin.emplace(where.client_cpu);
+  int64_t next = mono_ns();
+  pollfd p{sv[0], POLLIN, 0};
+  for (int64_t k = 0; k < frames && !ctx.stop.load(); ++k) {
+    canopen::CanFrame f = canopen::make_frame(0x201, {0x0f, 0x00, static_cast<uint8_t>(k), static_cast<uint8_t>(k >> 8)});
+    canopen::CanFrame g;
+    const int64_t t0 = mono_ns();
+    ::send(sv[0], &f, sizeof f, MSG_DONTWAIT | MSG_NOSIGNAL);
+    p.revents = 0;
+    if (::poll(&p, 1, 100) == 1 && ::recv(sv[0], &g, sizeof g, 0) == static_cast<ssize_t>(sizeof g) &&
+        g.data[2] == f.data[2]) {
+      hist.record(mono_ns() - t0);
+    } else {
+      ++lost;
+    }
+    next += period_ns;
+    sleep_until_ns(next);
+  }
+  ::shutdown(sv[0], SHUT_RDWR);
+  echo.join();
+  ::close(sv[0]);
+  ::close(sv[1]);
+}
+
 DistributionSummary can_round_trips(Context& ctx, bool through_transport, int64_t frames, int64_t period_ns,
                                     int64_t& lost, const Placement& where) {
   DurationHistogram hist(1000, 20000);
@@ -23,78 +106,9 @@ DistributionSummary can_round_trips(Context& ctx, bool through_transport, int64_
   std::optional<PinnedScope> pin;
   pin.emplace(where.server_cpu);  // the echo thread starts here
   if (through_transport) {
-    auto ends = socketpair_seqpacket();
-    CanTransport& a = ends.first;
-    CanTransport& b = ends.second;
-    std::thread echo([&b] {
-      canopen::CanFrame f;
-      for (;;) {
-        const auto rx = b.receive(f, 200);
-        if (rx == CanTransport::Rx::kFrame) {
-          b.send(f);
-        } else if (rx != CanTransport::Rx::kTimeout) {
-          return;
-        }
-      }
-    });
-    pin.emplace(where.client_cpu);  // and the sender runs here
-    int64_t next = mono_ns();
-    for (int64_t k = 0; k < frames && !ctx.stop.load(); ++k) {
-      canopen::CanFrame f = canopen::make_frame(0x201, {0x0f, 0x00, static_cast<uint8_t>(k), static_cast<uint8_t>(k >> 8)});
-      canopen::CanFrame g;
-      const int64_t t0 = mono_ns();
-      a.send(f);
-      if (a.receive(g, 100) == CanTransport::Rx::kFrame && g.data[2] == f.data[2]) {
-        hist.record(mono_ns() - t0);
-      } else {
-        ++lost;
-      }
-      next += period_ns;
-      sleep_until_ns(next);
-    }
-    a.shutdown();
-    echo.join();
+    transport_round_trips(ctx, frames, period_ns, lost, where, pin, hist);
   } else {
-    int sv[2];
-    if (::socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, sv) != 0) {
-      throw std::runtime_error(std::string("socketpair: ") + std::strerror(errno));
-    }
-    std::thread echo([fd = sv[1]] {
-      canopen::CanFrame f;
-      pollfd p{fd, POLLIN, 0};
-      for (;;) {
-        p.revents = 0;
-        const int rc = ::poll(&p, 1, 200);
-        if (rc < 0 && errno == EINTR) continue;
-        if (rc == 0) continue;
-        if (rc < 0 || (p.revents & (POLLHUP | POLLERR)) != 0) return;
-        const ssize_t n = ::recv(fd, &f, sizeof f, 0);
-        if (n <= 0) return;
-        ::send(fd, &f, sizeof f, MSG_DONTWAIT | MSG_NOSIGNAL);
-      }
-    });
-    pin.emplace(where.client_cpu);
-    int64_t next = mono_ns();
-    pollfd p{sv[0], POLLIN, 0};
-    for (int64_t k = 0; k < frames && !ctx.stop.load(); ++k) {
-      canopen::CanFrame f = canopen::make_frame(0x201, {0x0f, 0x00, static_cast<uint8_t>(k), static_cast<uint8_t>(k >> 8)});
-      canopen::CanFrame g;
-      const int64_t t0 = mono_ns();
-      ::send(sv[0], &f, sizeof f, MSG_DONTWAIT | MSG_NOSIGNAL);
-      p.revents = 0;
-      if (::poll(&p, 1, 100) == 1 && ::recv(sv[0], &g, sizeof g, 0) == static_cast<ssize_t>(sizeof g) &&
-          g.data[2] == f.data[2]) {
-        hist.record(mono_ns() - t0);
-      } else {
-        ++lost;
-      }
-      next += period_ns;
-      sleep_until_ns(next);
-    }
-    ::shutdown(sv[0], SHUT_RDWR);
-    echo.join();
-    ::close(sv[0]);
-    ::close(sv[1]);
+    bare_round_trips(ctx, frames, period_ns, lost, where, pin, hist);
   }
   return hist.summary();
 }

@@ -28,6 +28,116 @@ struct ModbusPair {
   DistributionSummary driver, bare;
 };
 
+// The driver: its I/O thread's own cycle times (ModbusDaq::io_latency)
+// while a loop writes its output each period.
+Json driver_cycles(Context& ctx, const ModbusDaqConfig& client, const Placement& where, int64_t cycles, int64_t period_ns,
+                   DistributionSummary& cycle_times) {
+  ModbusDaq daq(client);
+  {
+    PinnedScope pin(where.client_cpu);  // the I/O thread starts here and keeps the pin
+    daq.start(2.0);
+  }
+  const int64_t start = mono_ns();
+  for (int64_t k = 1; k <= cycles && !ctx.stop.load(); ++k) {
+    const double u = 0.1 * std::sin(static_cast<double>(k) * 0.01);
+    daq.write_outputs(&u, 1);  // what the loop does each tick
+    sleep_until_ns(start + k * period_ns);
+  }
+  cycle_times = daq.io_latency();
+  const ModbusDaqCounters c = daq.counters();
+  daq.stop();
+  Json d = Json::object();
+  d["what"] = "ModbusDaq I/O thread, one cycle = every planned read + the output write";
+  d["scheduling"] = client.io_priority > 0 ? "SCHED_FIFO " + std::to_string(client.io_priority) + " requested" : "normal";
+  d["cycle_time"] = latency_json(cycle_times);
+  d["timeouts"] = c.timeouts;
+  d["protocol_errors"] = c.protocol_errors;
+  d["cycle_overruns"] = c.cycle_overruns;
+  return d;
+}
+
+// One bare libmodbus client's cycles (on its own thread): every read of
+// the plan, then the writes. Returns an error text, "" when it ran.
+std::string bare_client_loop(Context& ctx, const ModbusDaqConfig& client, const ReadPlan& reads, const WritePlan& writes,
+                             int64_t cycles, int64_t period_ns, int64_t& failures, DistributionSummary& cycle_times) {
+  modbus_t* mb = modbus_new_tcp_pi(client.connection.host.c_str(), std::to_string(client.connection.port).c_str());
+  if (mb == nullptr) return "modbus_new_tcp_pi failed";
+  const auto timeout_us = static_cast<uint32_t>(std::llround(client.connection.response_timeout_s * 1e6));
+  modbus_set_response_timeout(mb, timeout_us / 1000000u, timeout_us % 1000000u);
+  if (modbus_connect(mb) != 0) {
+    const std::string error = std::string("connect: ") + modbus_strerror(errno);
+    modbus_free(mb);
+    return error;
+  }
+  DurationHistogram hist(1000, 20000);
+  std::vector<uint16_t> buffer(kMaxReadRegisters);
+  uint16_t out_regs[kMaxWriteRegisters] = {};
+  int64_t next = mono_ns();
+  for (int64_t k = 0; k < cycles && !ctx.stop.load(); ++k) {
+    const int64_t t0 = mono_ns();
+    bool ok = true;
+    for (const auto& blk : reads.blocks) {
+      modbus_set_slave(mb, blk.unit_id);
+      const int rc = blk.type == RegisterType::kInputRegister
+                         ? modbus_read_input_registers(mb, blk.address, blk.count, buffer.data())
+                         : modbus_read_registers(mb, blk.address, blk.count, buffer.data());
+      ok = ok && rc == blk.count;
+    }
+    out_regs[0] = static_cast<uint16_t>(k);
+    for (const auto& blk : writes.blocks) {
+      modbus_set_slave(mb, blk.unit_id);
+      const int rc = blk.count == 1 ? modbus_write_register(mb, blk.address, out_regs[0])
+                                    : modbus_write_registers(mb, blk.address, blk.count, out_regs);
+      ok = ok && rc == (blk.count == 1 ? 1 : blk.count);
+    }
+    if (ok) {
+      hist.record(mono_ns() - t0);
+    } else {
+      // The driver's recovery (ModbusLink::drain): a late reply must not
+      // be taken for the next request's, or the client stays one reply
+      // behind for good. Wait out one response timeout, then flush.
+      ++failures;
+      sleep_until_ns(mono_ns() + static_cast<int64_t>(timeout_us) * 1000);
+      modbus_flush(mb);
+    }
+    next += period_ns;
+    sleep_until_ns(next);
+  }
+  modbus_close(mb);
+  modbus_free(mb);
+  cycle_times = hist.summary();
+  return "";
+}
+
+// A bare libmodbus client, the driver's requests, period and priority.
+Json bare_cycles(Context& ctx, const ModbusDaqConfig& client, const Placement& where, int64_t cycles, int64_t period_ns,
+                 DistributionSummary& cycle_times) {
+  std::vector<ModbusPoint> in_points, out_points;
+  for (const auto& ch : client.inputs) in_points.push_back(ch.point);
+  for (const auto& ch : client.outputs) out_points.push_back(ch.point);
+  const ReadPlan reads = plan_reads(in_points, {client.max_gap, kMaxReadRegisters});
+  const WritePlan writes = plan_writes(out_points);
+  Json b = Json::object();
+  std::string error;
+  int64_t failures = 0;
+  std::optional<PinnedScope> pin;
+  pin.emplace(where.client_cpu);
+  std::thread t([&] {
+    b["scheduling"] = set_fifo(client.io_priority);
+    error = bare_client_loop(ctx, client, reads, writes, cycles, period_ns, failures, cycle_times);
+  });
+  pin.reset();
+  t.join();
+  if (!error.empty()) {
+    b["status"] = "error";
+    b["error"] = error;
+  }
+  b["what"] = "bare libmodbus client loop (modbus_read_input_registers + modbus_write_register), same plan";
+  b["cycle_time"] = latency_json(cycle_times);
+  b["failed_cycles"] = failures;
+  return b;
+}
+
 ModbusPair modbus_pair(Context& ctx, const ModbusDaqConfig& server_config, const Placement& where, double seconds) {
   ModbusPair out;
   Json& j = out.json;
@@ -45,113 +155,12 @@ ModbusPair modbus_pair(Context& ctx, const ModbusDaqConfig& server_config, const
   server.set_inputs(inputs.data(), inputs.size());
   const int64_t period_ns = std::llround(client.poll_period_s * 1e9);
   const int64_t cycles = std::llround(seconds / client.poll_period_s);
-
-  // The driver: its I/O thread's own cycle times (ModbusDaq::io_latency).
-  {
-    ModbusDaq daq(client);
-    {
-      PinnedScope pin(where.client_cpu);  // the I/O thread starts here and keeps the pin
-      daq.start(2.0);
-    }
-    const int64_t start = mono_ns();
-    for (int64_t k = 1; k <= cycles && !ctx.stop.load(); ++k) {
-      const double u = 0.1 * std::sin(static_cast<double>(k) * 0.01);
-      daq.write_outputs(&u, 1);  // what the loop does each tick
-      sleep_until_ns(start + k * period_ns);
-    }
-    out.driver = daq.io_latency();
-    const ModbusDaqCounters c = daq.counters();
-    daq.stop();
-    Json d = Json::object();
-    d["what"] = "ModbusDaq I/O thread, one cycle = every planned read + the output write";
-    d["scheduling"] = client.io_priority > 0 ? "SCHED_FIFO " + std::to_string(client.io_priority) + " requested" : "normal";
-    d["cycle_time"] = latency_json(out.driver);
-    d["timeouts"] = c.timeouts;
-    d["protocol_errors"] = c.protocol_errors;
-    d["cycle_overruns"] = c.cycle_overruns;
-    j["driver"] = d;
-  }
-
-  // A bare libmodbus client, same requests, period and priority.
-  {
-    std::vector<ModbusPoint> in_points, out_points;
-    for (const auto& ch : client.inputs) in_points.push_back(ch.point);
-    for (const auto& ch : client.outputs) out_points.push_back(ch.point);
-    const ReadPlan reads = plan_reads(in_points, {client.max_gap, kMaxReadRegisters});
-    const WritePlan writes = plan_writes(out_points);
-    Json b = Json::object();
-    std::string error;
-    int64_t failures = 0;
-    std::optional<PinnedScope> pin;
-    pin.emplace(where.client_cpu);
-    std::thread t([&] {
-      b["scheduling"] = set_fifo(client.io_priority);
-      modbus_t* mb = modbus_new_tcp_pi(client.connection.host.c_str(), std::to_string(client.connection.port).c_str());
-      if (mb == nullptr) {
-        error = "modbus_new_tcp_pi failed";
-        return;
-      }
-      const auto timeout_us = static_cast<uint32_t>(std::llround(client.connection.response_timeout_s * 1e6));
-      modbus_set_response_timeout(mb, timeout_us / 1000000u, timeout_us % 1000000u);
-      if (modbus_connect(mb) != 0) {
-        error = std::string("connect: ") + modbus_strerror(errno);
-        modbus_free(mb);
-        return;
-      }
-      DurationHistogram hist(1000, 20000);
-      std::vector<uint16_t> buffer(kMaxReadRegisters);
-      uint16_t out_regs[kMaxWriteRegisters] = {};
-      int64_t next = mono_ns();
-      for (int64_t k = 0; k < cycles && !ctx.stop.load(); ++k) {
-        const int64_t t0 = mono_ns();
-        bool ok = true;
-        for (const auto& blk : reads.blocks) {
-          modbus_set_slave(mb, blk.unit_id);
-          const int rc = blk.type == RegisterType::kInputRegister
-                             ? modbus_read_input_registers(mb, blk.address, blk.count, buffer.data())
-                             : modbus_read_registers(mb, blk.address, blk.count, buffer.data());
-          ok = ok && rc == blk.count;
-        }
-        out_regs[0] = static_cast<uint16_t>(k);
-        for (const auto& blk : writes.blocks) {
-          modbus_set_slave(mb, blk.unit_id);
-          const int rc = blk.count == 1 ? modbus_write_register(mb, blk.address, out_regs[0])
-                                        : modbus_write_registers(mb, blk.address, blk.count, out_regs);
-          ok = ok && rc == (blk.count == 1 ? 1 : blk.count);
-        }
-        if (ok) {
-          hist.record(mono_ns() - t0);
-        } else {
-          // The driver's recovery (ModbusLink::drain): a late reply must not
-          // be taken for the next request's, or the client stays one reply
-          // behind for good. Wait out one response timeout, then flush.
-          ++failures;
-          sleep_until_ns(mono_ns() + static_cast<int64_t>(timeout_us) * 1000);
-          modbus_flush(mb);
-        }
-        next += period_ns;
-        sleep_until_ns(next);
-      }
-      modbus_close(mb);
-      modbus_free(mb);
-      out.bare = hist.summary();
-    });
-    pin.reset();
-    t.join();
-    if (!error.empty()) {
-      b["status"] = "error";
-      b["error"] = error;
-    }
-    b["what"] = "bare libmodbus client loop (modbus_read_input_registers + modbus_write_register), same plan";
-    b["cycle_time"] = latency_json(out.bare);
-    b["failed_cycles"] = failures;
-    j["bare_libmodbus"] = b;
-  }
+  j["driver"] = driver_cycles(ctx, client, where, cycles, period_ns, out.driver);
+  j["bare_libmodbus"] = bare_cycles(ctx, client, where, cycles, period_ns, out.bare);
   server.stop();
   j["ratio_driver_over_bare"] = comparison_row(out.driver, out.bare);
   return out;
 }
-
 
 }  // namespace
 

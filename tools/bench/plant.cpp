@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <span>
 
 #include "config/rig_config.hpp"
@@ -58,6 +59,18 @@ CommandSeries closed_loop_commands(const RigConfig& config, int64_t ticks) {
   // A run that ended early (a limit) holds the safe command for the rest.
   while (static_cast<int64_t>(u.size()) < ticks) u.push_back({0.0, 0.0});
   return u;
+}
+
+PlantInputs::PlantInputs(const Context& ctx, double seconds)
+    : qc(load_rig_config(ctx.quarter_car_config)),
+      pn(load_rig_config(ctx.pneumatic_config)),
+      T(qc.loop.period_s),
+      ticks(static_cast<int64_t>(std::llround(seconds / T))),
+      qc_u(closed_loop_commands(qc, ticks)),
+      pn_u(closed_loop_commands(pn, static_cast<int64_t>(std::llround(seconds / pn.loop.period_s)))),
+      passive(static_cast<std::size_t>(ticks), HeldCommand{0.0, 0.0}) {
+  iso.road.kind = RoadKind::kIso8608;
+  iso.road.iso.road_class = IsoRoadClass::kC;
 }
 
 namespace {
@@ -205,141 +218,163 @@ std::pair<std::vector<decltype(std::declval<Plant>().state())>, std::vector<Held
   return {states, cmds};
 }
 
+// The section's settings: full or --quick.
+struct PlantRunSettings {
+  double sim_s = 0.0;
+  double tolerance = 0.0;
+  int repetitions = 0;
+  double T = 0.0;
+};
+
+// The four plants, each with its fixed-step runs, its reference and its
+// right-hand side check; they read `in`, which must outlive them.
+std::vector<Case> plant_cases(const PlantInputs& in, const std::atomic<bool>& stop) {
+  std::vector<Case> cases;
+  const double T = in.T;
+  cases.push_back({"quarter_car", "config/quarter_car.yaml plant (hydraulics, leakage, bearing stick-slip), commands of its PI closed loop on the 50 mm step test",
+                   "x_r", quarter_car_substeps(in.qc.quarter_car, T),
+                   [&in, T](int n, int reps) { return run_fixed<QuarterCarPlant>(in.qc.quarter_car, n, in.qc_u, T, reps); },
+                   [&in, T, &stop](double tol) { return reference_quarter_car(in.qc.quarter_car, in.qc_u, T, tol, stop); },
+                   [&in, T](const FixedRun& f, int& checked) {
+                     const auto [s, c] = sample_states<QuarterCarPlant>(in.qc.quarter_car, in.qc_u, T, 50);
+                     return rhs_agreement_quarter_car(in.qc.quarter_car, s, c, T / f.substeps, checked);
+                   },
+                   quarter_car_state_names()});
+  const double Tp = in.pn.loop.period_s;
+  cases.push_back({"pneumatic_rotary", "config/pneumatic_rotary.yaml plant (dither, bladder hysteresis stick-slip), commands of its PVP closed loop (fig4c)",
+                   "theta", in.pn.pneumatic_rotary.substeps,
+                   [&in, Tp](int n, int reps) { return run_fixed<PneumaticRotaryPlant>(in.pn.pneumatic_rotary, n, in.pn_u, Tp, reps); },
+                   [&in, Tp, &stop](double tol) { return reference_pneumatic(in.pn.pneumatic_rotary, in.pn_u, Tp, tol, stop); },
+                   [&in, Tp](const FixedRun& f, int& checked) {
+                     const auto [s, c] = sample_states<PneumaticRotaryPlant>(in.pn.pneumatic_rotary, in.pn_u, Tp, 50);
+                     return rhs_agreement_pneumatic(in.pn.pneumatic_rotary, s, c, Tp / f.substeps, checked);
+                   },
+                   pneumatic_state_names()});
+  for (const HalfCarParams* hp : {&in.bump, &in.iso}) {
+    const bool is_bump = hp == &in.bump;
+    cases.push_back({is_bump ? "half_car_bump" : "half_car_iso_c",
+                     is_bump ? "half car, pitch plane, the paper's double bump at 0.5 s, 20 m/s, passive"
+                             : "half car, pitch plane, ISO 8608 class C road at 20 m/s, passive",
+                     "z_s", hp->substeps,
+                     [&in, hp, T](int n, int reps) { return run_fixed<HalfCarPlant>(*hp, n, in.passive, T, reps); },
+                     [&in, hp, T, &stop](double tol) { return reference_half_car(*hp, in.passive, T, tol, stop); },
+                     [&in, hp, T](const FixedRun& f, int& checked) {
+                       const auto [s, c] = sample_states<HalfCarPlant>(*hp, in.passive, T, 50);
+                       return rhs_agreement_half_car(*hp, s, c, T / f.substeps, checked);
+                     },
+                     half_car_state_names()});
+  }
+  return cases;
+}
+
+// The plant's fixed-step RK4 at 1/4..4x its sub-steps against the
+// reference: a JSON entry and a table row each; at the loop's own sub-steps
+// also the right-hand side check (into cj).
+Json fixed_step_runs(Case& c, const PlantRunSettings& r, const ReferenceResult& ref, std::size_t out_index, Context& ctx,
+                     Table& table, Json& cj) {
+  Json fixed = Json::array();
+  std::vector<int> substeps;
+  for (const double m : {0.25, 0.5, 1.0, 2.0, 4.0}) {
+    const int n = std::max(1, static_cast<int>(std::lround(c.default_substeps * m)));
+    if (std::find(substeps.begin(), substeps.end(), n) == substeps.end()) substeps.push_back(n);
+  }
+  const double T = r.T;
+  for (const int n : substeps) {
+    const FixedRun f = c.fixed(n, r.repetitions);
+    const ErrorSummary e = compare(f.at, ref.at, c.names);
+    Json fj = Json::object();
+    fj["substeps"] = n;
+    fj["step_us"] = T / n * 1e6;
+    fj["wall_s"] = f.wall_s;
+    fj["real_time_factor"] = ratio(r.sim_s, f.wall_s);
+    fj["speedup_over_reference"] = ratio(ref.stats.wall_s, f.wall_s);
+    fj["error"] = error_json(e, c.names);
+    if (n == c.default_substeps) {
+      int checked = 0;
+      const double agreement = c.agreement(f, checked);
+      Json a = Json::object();
+      a["max_relative_difference"] = agreement;
+      a["states_checked"] = checked;
+      a["what"] = "one RK4 sub-step by the plant vs by the reference's right-hand side, from the same states";
+      cj["rhs_agreement"] = a;
+      ctx.out << "  " << c.name << ": reference right-hand side agrees with the plant's to "
+              << fmt("%.1e", agreement) << " (" << checked << " states)\n";
+    }
+    fixed.push_back(fj);
+    table.row({c.name, n == c.default_substeps ? "RK4 (loop)" : "RK4", std::to_string(n),
+               fmt("%.1f", T / n * 1e6), fmt("%.0f", ratio(r.sim_s, f.wall_s)), c.output,
+               fmt("%.3g", e.max_abs[out_index]), fmt("%.3g", e.rms[out_index]),
+               fmt("%.2e", e.worst_normalized) + " " + e.worst_component});
+  }
+  return fixed;
+}
+
+// One plant measured: its reference (and, in a full run, how converged that
+// is), its fixed-step runs. Empty when the reference was stopped.
+std::optional<Json> measure_case(Case& c, const PlantRunSettings& r, Context& ctx, Table& table) {
+  Json cj = Json::object();
+  cj["description"] = c.description;
+  cj["output"] = c.output;
+  cj["default_substeps"] = c.default_substeps;
+  const std::size_t out_index =
+      static_cast<std::size_t>(std::find(c.names.begin(), c.names.end(), c.output) - c.names.begin());
+
+  ReferenceResult ref = c.reference(r.tolerance);
+  if (!ref.completed) return std::nullopt;
+  cj["reference"] = stats_json(ref.stats, r.sim_s);
+  if (!ctx.quick()) {
+    // How far the reference itself is from converged: the same at 10x the tolerance.
+    const ReferenceResult loose = c.reference(r.tolerance * 10);
+    const ErrorSummary self = compare(loose.at, ref.at, c.names);
+    Json sj = Json::object();
+    sj["tolerance"] = r.tolerance * 10;
+    sj["wall_s"] = loose.stats.wall_s;
+    sj["difference"] = error_json(self, c.names);
+    cj["reference_at_10x_tolerance"] = sj;
+  }
+  cj["fixed_step"] = fixed_step_runs(c, r, ref, out_index, ctx, table, cj);
+  table.row({c.name, "dopri5 " + fmt("%.0e", r.tolerance), "-", fmt("%.2f", ref.stats.wall_s > 0 ? r.sim_s * 1e6 / static_cast<double>(ref.stats.steps) : NAN),
+             fmt("%.1f", ratio(r.sim_s, ref.stats.wall_s)), c.output, "(reference)", "", 
+             std::to_string(ref.stats.events) + " switches"});
+  return cj;
+}
+
+Json run_plant_section(Context& ctx) {
+  PlantRunSettings r;
+  r.sim_s = ctx.pick(20.0, 2.0);
+  r.tolerance = ctx.pick(1e-10, 1e-8);
+  r.repetitions = ctx.pick(3, 1);
+  const PlantInputs inputs(ctx, r.sim_s);
+  r.T = inputs.T;
+  std::vector<Case> cases = plant_cases(inputs, ctx.stop);
+
+  Json j = Json::object();
+  j["simulated_s"] = r.sim_s;
+  j["period_s"] = r.T;
+  j["reference_tolerance"] = r.tolerance;
+  j["timing"] = "wall time of the plant's advance() over every period (best of " + std::to_string(r.repetitions) +
+                " runs, one when a run takes over 1 s), single thread; real-time factor = simulated time / wall time";
+  j["error"] = "state at every period end against the reference; max_abs_over_range = max |error| / (max - min of the reference)";
+  Json out_cases = Json::object();
+  ctx.out << "  " << r.sim_s << " s simulated per run, period " << r.T * 1e3 << " ms, reference dopri5 at "
+          << r.tolerance << "\n";
+  Table table({"plant", "integrator", "substeps", "step us", "real-time x", "output", "max err", "rms err",
+               "worst err/range"});
+  for (auto& c : cases) {
+    if (ctx.stop.load()) break;
+    std::optional<Json> cj = measure_case(c, r, ctx, table);
+    if (!cj) break;
+    out_cases[c.name] = *cj;
+  }
+  j["cases"] = out_cases;
+  ctx.out << table.text();
+  return j;
+}
+
 }  // namespace
 
 Section plant_section() {
-  return {"plant", "plant: speed and accuracy of the fixed-step RK4 against an adaptive reference", [](Context& ctx) {
-            const double sim_s = ctx.pick(20.0, 2.0);
-            const double tolerance = ctx.pick(1e-10, 1e-8);
-            const int repetitions = ctx.pick(3, 1);
-            const RigConfig qc = load_rig_config(ctx.quarter_car_config);
-            const RigConfig pn = load_rig_config(ctx.pneumatic_config);
-            const double T = qc.loop.period_s;
-            const auto ticks = static_cast<int64_t>(std::llround(sim_s / T));
-
-            const CommandSeries qc_u = closed_loop_commands(qc, ticks);
-            const CommandSeries pn_u = closed_loop_commands(pn, static_cast<int64_t>(std::llround(sim_s / pn.loop.period_s)));
-            const CommandSeries passive(static_cast<std::size_t>(ticks), HeldCommand{0.0, 0.0});
-            HalfCarParams bump;  // the pitch-plane set with the paper's bump road
-            HalfCarParams iso;
-            iso.road.kind = RoadKind::kIso8608;
-            iso.road.iso.road_class = IsoRoadClass::kC;
-
-            const std::atomic<bool>& stop = ctx.stop;
-            std::vector<Case> cases;
-            cases.push_back({"quarter_car", "config/quarter_car.yaml plant (hydraulics, leakage, bearing stick-slip), commands of its PI closed loop on the 50 mm step test",
-                             "x_r", quarter_car_substeps(qc.quarter_car, T),
-                             [&](int n, int reps) { return run_fixed<QuarterCarPlant>(qc.quarter_car, n, qc_u, T, reps); },
-                             [&](double tol) { return reference_quarter_car(qc.quarter_car, qc_u, T, tol, stop); },
-                             [&](const FixedRun& f, int& checked) {
-                               const auto [s, c] = sample_states<QuarterCarPlant>(qc.quarter_car, qc_u, T, 50);
-                               return rhs_agreement_quarter_car(qc.quarter_car, s, c, T / f.substeps, checked);
-                             },
-                             quarter_car_state_names()});
-            const double Tp = pn.loop.period_s;
-            cases.push_back({"pneumatic_rotary", "config/pneumatic_rotary.yaml plant (dither, bladder hysteresis stick-slip), commands of its PVP closed loop (fig4c)",
-                             "theta", pn.pneumatic_rotary.substeps,
-                             [&](int n, int reps) { return run_fixed<PneumaticRotaryPlant>(pn.pneumatic_rotary, n, pn_u, Tp, reps); },
-                             [&](double tol) { return reference_pneumatic(pn.pneumatic_rotary, pn_u, Tp, tol, stop); },
-                             [&](const FixedRun& f, int& checked) {
-                               const auto [s, c] = sample_states<PneumaticRotaryPlant>(pn.pneumatic_rotary, pn_u, Tp, 50);
-                               return rhs_agreement_pneumatic(pn.pneumatic_rotary, s, c, Tp / f.substeps, checked);
-                             },
-                             pneumatic_state_names()});
-            for (auto* hp : {&bump, &iso}) {
-              const HalfCarParams& p = *hp;
-              const bool is_bump = hp == &bump;
-              cases.push_back({is_bump ? "half_car_bump" : "half_car_iso_c",
-                               is_bump ? "half car, pitch plane, the paper's double bump at 0.5 s, 20 m/s, passive"
-                                       : "half car, pitch plane, ISO 8608 class C road at 20 m/s, passive",
-                               "z_s", p.substeps,
-                               [&, hp](int n, int reps) { return run_fixed<HalfCarPlant>(*hp, n, passive, T, reps); },
-                               [&, hp](double tol) { return reference_half_car(*hp, passive, T, tol, stop); },
-                               [&, hp](const FixedRun& f, int& checked) {
-                                 const auto [s, c] = sample_states<HalfCarPlant>(*hp, passive, T, 50);
-                                 return rhs_agreement_half_car(*hp, s, c, T / f.substeps, checked);
-                               },
-                               half_car_state_names()});
-            }
-
-            Json j = Json::object();
-            j["simulated_s"] = sim_s;
-            j["period_s"] = T;
-            j["reference_tolerance"] = tolerance;
-            j["timing"] = "wall time of the plant's advance() over every period (best of " + std::to_string(repetitions) +
-                          " runs, one when a run takes over 1 s), single thread; real-time factor = simulated time / wall time";
-            j["error"] = "state at every period end against the reference; max_abs_over_range = max |error| / (max - min of the reference)";
-            Json out_cases = Json::object();
-            ctx.out << "  " << sim_s << " s simulated per run, period " << T * 1e3 << " ms, reference dopri5 at "
-                    << tolerance << "\n";
-            Table table({"plant", "integrator", "substeps", "step us", "real-time x", "output", "max err", "rms err",
-                         "worst err/range"});
-            for (auto& c : cases) {
-              if (ctx.stop.load()) break;
-              Json cj = Json::object();
-              cj["description"] = c.description;
-              cj["output"] = c.output;
-              cj["default_substeps"] = c.default_substeps;
-              const std::size_t out_index =
-                  static_cast<std::size_t>(std::find(c.names.begin(), c.names.end(), c.output) - c.names.begin());
-
-              ReferenceResult ref = c.reference(tolerance);
-              if (!ref.completed) break;
-              cj["reference"] = stats_json(ref.stats, sim_s);
-              if (!ctx.quick()) {
-                // How far the reference itself is from converged: the same at 10x the tolerance.
-                const ReferenceResult loose = c.reference(tolerance * 10);
-                const ErrorSummary self = compare(loose.at, ref.at, c.names);
-                Json sj = Json::object();
-                sj["tolerance"] = tolerance * 10;
-                sj["wall_s"] = loose.stats.wall_s;
-                sj["difference"] = error_json(self, c.names);
-                cj["reference_at_10x_tolerance"] = sj;
-              }
-
-              Json fixed = Json::array();
-              std::vector<int> substeps;
-              for (const double m : {0.25, 0.5, 1.0, 2.0, 4.0}) {
-                const int n = std::max(1, static_cast<int>(std::lround(c.default_substeps * m)));
-                if (std::find(substeps.begin(), substeps.end(), n) == substeps.end()) substeps.push_back(n);
-              }
-              for (const int n : substeps) {
-                const FixedRun f = c.fixed(n, repetitions);
-                const ErrorSummary e = compare(f.at, ref.at, c.names);
-                Json fj = Json::object();
-                fj["substeps"] = n;
-                fj["step_us"] = T / n * 1e6;
-                fj["wall_s"] = f.wall_s;
-                fj["real_time_factor"] = ratio(sim_s, f.wall_s);
-                fj["speedup_over_reference"] = ratio(ref.stats.wall_s, f.wall_s);
-                fj["error"] = error_json(e, c.names);
-                if (n == c.default_substeps) {
-                  int checked = 0;
-                  const double agreement = c.agreement(f, checked);
-                  Json a = Json::object();
-                  a["max_relative_difference"] = agreement;
-                  a["states_checked"] = checked;
-                  a["what"] = "one RK4 sub-step by the plant vs by the reference's right-hand side, from the same states";
-                  cj["rhs_agreement"] = a;
-                  ctx.out << "  " << c.name << ": reference right-hand side agrees with the plant's to "
-                          << fmt("%.1e", agreement) << " (" << checked << " states)\n";
-                }
-                fixed.push_back(fj);
-                table.row({c.name, n == c.default_substeps ? "RK4 (loop)" : "RK4", std::to_string(n),
-                           fmt("%.1f", T / n * 1e6), fmt("%.0f", ratio(sim_s, f.wall_s)), c.output,
-                           fmt("%.3g", e.max_abs[out_index]), fmt("%.3g", e.rms[out_index]),
-                           fmt("%.2e", e.worst_normalized) + " " + e.worst_component});
-              }
-              cj["fixed_step"] = fixed;
-              table.row({c.name, "dopri5 " + fmt("%.0e", tolerance), "-", fmt("%.2f", ref.stats.wall_s > 0 ? sim_s * 1e6 / static_cast<double>(ref.stats.steps) : NAN),
-                         fmt("%.1f", ratio(sim_s, ref.stats.wall_s)), c.output, "(reference)", "", 
-                         std::to_string(ref.stats.events) + " switches"});
-              out_cases[c.name] = cj;
-            }
-            j["cases"] = out_cases;
-            ctx.out << table.text();
-            return j;
-          }};
+  return {"plant", "plant: speed and accuracy of the fixed-step RK4 against an adaptive reference", run_plant_section};
 }
 
 }  // namespace rigctl::bench

@@ -76,4 +76,22 @@ LoopRun run_loop(Context& ctx, double seconds, const std::string& tag,
 // replay, so that the fixed-step plant and its reference see the same input.
 CommandSeries closed_loop_commands(const RigConfig& config, int64_t ticks);
 
+// What the plant benchmarks (plant, scaling) drive the plants with, made
+// once per section: the shipped quarter-car and pneumatic configs with
+// their closed loops' commands over `seconds` (each at its own period), and
+// the half car's passive run at the quarter car's period with its two
+// roads. Defined in tools/bench/plant.cpp.
+struct PlantInputs {
+  PlantInputs(const Context& ctx, double seconds);
+  const RigConfig qc;
+  const RigConfig pn;
+  const double T;        // the quarter car's period, the half car's too
+  const int64_t ticks;   // of T over `seconds`
+  const CommandSeries qc_u;
+  const CommandSeries pn_u;
+  const CommandSeries passive;
+  HalfCarParams bump;    // the pitch-plane set with the paper's double bump road
+  HalfCarParams iso;     // the same on an ISO 8608 class C road
+};
+
 }  // namespace rigctl::bench

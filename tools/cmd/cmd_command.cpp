@@ -136,41 +136,102 @@ int64_t reserve_sequence(const std::string& state_path, int64_t now_utime) {
   return next;
 }
 
-int run_cmd_command(const CmdOptions& o, std::ostream& out, std::ostream& err) {
-  // Command name: the CLI's hyphens are the wire's underscores.
-  std::string name = o.command;
-  std::replace(name.begin(), name.end(), '-', '_');
+namespace {
+
+// The command as the wire carries it, from the command line.
+struct CommandToSend {
+  std::string name;  // the wire's name: the CLI's hyphens as underscores
   OperatorCommandKind kind{};
-  if (!parse_command_name(name, kind)) {
+  double value = 0.0;
+  std::string sender;
+};
+
+// Checks the command line; on a usage error writes why on `err` and returns false.
+bool read_command(const CmdOptions& o, CommandToSend& c, std::ostream& err) {
+  c.name = o.command;
+  std::replace(c.name.begin(), c.name.end(), '-', '_');
+  if (!parse_command_name(c.name, c.kind)) {
     err << "rigctl cmd: unknown command '" << o.command
         << "' (arm start hold resume stop reset hydraulics-low hydraulics-high hydraulics-off setpoint VALUE)\n";
-    return kCmdUsage;
+    return false;
   }
-  double value = 0.0;
-  if (kind == OperatorCommandKind::kSetpoint) {
+  if (c.kind == OperatorCommandKind::kSetpoint) {
     char* end = nullptr;
-    value = o.value.empty() ? std::nan("") : std::strtod(o.value.c_str(), &end);
-    if (o.value.empty() || end == nullptr || *end != '\0' || !std::isfinite(value)) {
+    c.value = o.value.empty() ? std::nan("") : std::strtod(o.value.c_str(), &end);
+    if (o.value.empty() || end == nullptr || *end != '\0' || !std::isfinite(c.value)) {
       err << "rigctl cmd: setpoint needs a finite number VALUE (SI units), got '" << o.value << "'\n";
-      return kCmdUsage;
+      return false;
     }
   } else if (!o.value.empty()) {
     err << "rigctl cmd: '" << o.command << "' takes no value (got '" << o.value << "')\n";
-    return kCmdUsage;
+    return false;
   }
   if (o.key_path.empty()) {
     err << "rigctl cmd: --key FILE is required\n";
-    return kCmdUsage;
+    return false;
   }
   if (!(o.wait_ack_s >= 0.0) || o.wait_ack_s > 3600.0) {
     err << "rigctl cmd: --wait-ack must be 0..3600 s\n";
-    return kCmdUsage;
+    return false;
   }
-  const std::string sender = o.sender.empty() ? default_sender() : o.sender;
-  if (!valid_sender_id(sender)) {
-    err << "rigctl cmd: --sender '" << sender << "' must be 1-64 characters of [A-Za-z0-9_.@-]\n";
-    return kCmdUsage;
+  c.sender = o.sender.empty() ? default_sender() : o.sender;
+  if (!valid_sender_id(c.sender)) {
+    err << "rigctl cmd: --sender '" << c.sender << "' must be 1-64 characters of [A-Za-z0-9_.@-]\n";
+    return false;
   }
+  return true;
+}
+
+// The signed message with the sender's next sequence number (reserved in its state file).
+operator_command_t signed_message(const CmdOptions& o, const CommandToSend& c, const OperatorKey& key) {
+  operator_command_t msg;
+  msg.version = kOperatorWireVersion;
+  msg.sender = c.sender;
+  msg.command = c.name;
+  msg.value = c.value;
+  msg.utime = wall_utime_now();
+  msg.sequence = reserve_sequence(o.state_path.empty() ? default_sequence_state_path(c.sender) : o.state_path, msg.utime);
+  sign(msg, key);
+  return msg;
+}
+
+// Handles LCM until the waiter has its acknowledgement or wait_s has passed.
+void wait_for_ack(lcm::LCM& lcm, const AckWaiter& waiter, double wait_s, const std::string& ack_channel) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(wait_s);
+  while (!waiter.got) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    if (left.count() <= 0) break;
+    if (lcm.handleTimeout(static_cast<int>(std::min<int64_t>(left.count(), 100))) < 0) {
+      throw std::runtime_error("receiving on " + ack_channel + " failed");
+    }
+  }
+}
+
+// What the rig replied (or that it did not), and the exit code saying so.
+int report_reply(const CmdOptions& o, const AckWaiter& waiter, const std::string& what, const std::string& ack_channel,
+                 std::ostream& out) {
+  if (!waiter.got) {
+    out << "rigctl cmd: " << what << " sent on " << o.channel << ", no acknowledgement on " << ack_channel
+        << " within " << format_seconds(o.wait_ack_s) << " s"
+        << (waiter.bad_tags > 0 ? " (" + std::to_string(waiter.bad_tags) +
+                                      " reply with a tag that does not verify: the rig has a different key?)"
+                                : " (is the rig running, on this LCM URL and channel?)")
+        << "\n";
+    return kCmdNoAck;
+  }
+  if (waiter.ack.accepted) {
+    out << "rigctl cmd: " << what << " accepted by the rig\n";
+    return kCmdAccepted;
+  }
+  out << "rigctl cmd: " << what << " rejected by the rig: " << waiter.ack.reason << ": " << waiter.ack.message << "\n";
+  return kCmdRejected;
+}
+
+}  // namespace
+
+int run_cmd_command(const CmdOptions& o, std::ostream& out, std::ostream& err) {
+  CommandToSend c;
+  if (!read_command(o, c, err)) return kCmdUsage;
   const std::string ack_channel = o.ack_channel.empty() ? o.channel + "_ACK" : o.ack_channel;
 
   try {
@@ -180,51 +241,22 @@ int run_cmd_command(const CmdOptions& o, std::ostream& out, std::ostream& err) {
     lcm::LCM lcm(o.lcm_url);
     if (!lcm.good()) throw std::runtime_error("cannot open LCM URL '" + o.lcm_url + "'");
 
-    operator_command_t msg;
-    msg.version = kOperatorWireVersion;
-    msg.sender = sender;
-    msg.command = name;
-    msg.value = value;
-    msg.utime = wall_utime_now();
-    msg.sequence = reserve_sequence(o.state_path.empty() ? default_sequence_state_path(sender) : o.state_path, msg.utime);
-    sign(msg, key);
+    const operator_command_t msg = signed_message(o, c, key);
     const auto bytes = lcm_encode(msg);
-
-    AckWaiter waiter{&key, sender, msg.sequence, false, {}, 0};
+    AckWaiter waiter{&key, c.sender, msg.sequence, false, {}, 0};
     // Subscribed before sending, so a fast reply is not missed.
     if (o.wait_ack_s > 0.0) lcm.subscribe(regex_literal(ack_channel), &AckWaiter::on_message, &waiter);
     if (lcm.publish(o.channel, bytes.data(), static_cast<unsigned int>(bytes.size())) != 0) {
       throw std::runtime_error("publishing on " + o.channel + " failed");
     }
-    const std::string what = "'" + o.command + (kind == OperatorCommandKind::kSetpoint ? " " + o.value : "") +
-                             "' (sender " + sender + ", sequence " + std::to_string(msg.sequence) + ")";
+    const std::string what = "'" + o.command + (c.kind == OperatorCommandKind::kSetpoint ? " " + o.value : "") +
+                             "' (sender " + c.sender + ", sequence " + std::to_string(msg.sequence) + ")";
     if (o.wait_ack_s == 0.0) {
       out << "rigctl cmd: " << what << " sent on " << o.channel << ", not waiting for an acknowledgement\n";
       return kCmdAccepted;
     }
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.wait_ack_s);
-    while (!waiter.got) {
-      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
-      if (left.count() <= 0) break;
-      if (lcm.handleTimeout(static_cast<int>(std::min<int64_t>(left.count(), 100))) < 0) {
-        throw std::runtime_error("receiving on " + ack_channel + " failed");
-      }
-    }
-    if (!waiter.got) {
-      out << "rigctl cmd: " << what << " sent on " << o.channel << ", no acknowledgement on " << ack_channel
-          << " within " << format_seconds(o.wait_ack_s) << " s"
-          << (waiter.bad_tags > 0 ? " (" + std::to_string(waiter.bad_tags) +
-                                        " reply with a tag that does not verify: the rig has a different key?)"
-                                  : " (is the rig running, on this LCM URL and channel?)")
-          << "\n";
-      return kCmdNoAck;
-    }
-    if (waiter.ack.accepted) {
-      out << "rigctl cmd: " << what << " accepted by the rig\n";
-      return kCmdAccepted;
-    }
-    out << "rigctl cmd: " << what << " rejected by the rig: " << waiter.ack.reason << ": " << waiter.ack.message << "\n";
-    return kCmdRejected;
+    wait_for_ack(lcm, waiter, o.wait_ack_s, ack_channel);
+    return report_reply(o, waiter, what, ack_channel, out);
   } catch (const std::exception& e) {
     err << "rigctl cmd: " << e.what() << "\n";
     return kCmdError;

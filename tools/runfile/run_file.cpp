@@ -111,107 +111,107 @@ RunFileOptions run_file_columns(RunFileRig rig) {
   return o;
 }
 
-RunFile parse_run_file(std::istream& in, const std::string& name, const RunFileOptions& options) {
-  auto fail = [&](const std::string& what) -> RunFileError { return RunFileError(name + ": " + what); };
-  RunFile rf;
-  std::string line;
-  std::size_t line_no = 0;
-  bool have_header = false;
-  // index in the row -> column name, for the checked columns (t included)
-  std::vector<std::pair<std::size_t, std::string>> checked;
-  std::vector<std::vector<double>> values;
-  std::vector<std::size_t> row_line;  // file line of each kept row
-  const bool keep_all = options.required.empty() && options.optional.empty();
+namespace {
 
-  while (std::getline(in, line)) {
-    ++line_no;
-    if (line_no == 1 && line.size() >= 3 && line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3);
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (!have_header) {
-      const std::string tl = trim(line);
-      if (tl.empty()) continue;
-      if (tl[0] == '#') {
-        const std::string body = trim(tl.substr(1));
-        const auto colon = body.find(':');
-        if (colon != std::string::npos) rf.metadata.emplace_back(trim(body.substr(0, colon)), trim(body.substr(colon + 1)));
-        continue;
-      }
-      rf.header = split(line);
-      if (rf.header.empty() || rf.header[0] != "t")
-        throw fail("line " + std::to_string(line_no) + ": the first column must be 't' (found '" +
-                   (rf.header.empty() ? std::string() : rf.header[0]) + "')");
-      std::set<std::string> seen;
-      for (const auto& h : rf.header) {
-        if (h.empty()) throw fail("line " + std::to_string(line_no) + ": empty column name in the header");
-        if (!seen.insert(h).second) throw fail("line " + std::to_string(line_no) + ": duplicate column '" + h + "'");
-      }
-      for (const auto& r : options.required)
-        if (!seen.count(r)) throw fail("missing required column '" + r + "'");
-      for (std::size_t i = 0; i < rf.header.size(); ++i) {
-        const auto& h = rf.header[i];
-        const bool known = i == 0 || keep_all ||
-                           std::find(options.required.begin(), options.required.end(), h) != options.required.end() ||
-                           std::find(options.optional.begin(), options.optional.end(), h) != options.optional.end();
-        if (known) checked.emplace_back(i, h);
-      }
-      values.assign(checked.size(), {});
-      have_header = true;
-      continue;
-    }
-    if (trim(line).empty()) continue;  // a trailing blank line
-    const auto cells = split(line);
-    std::string error;
-    if (cells.size() < rf.header.size()) {
-      error = "line " + std::to_string(line_no) + ": short row, " + std::to_string(cells.size()) + " cells for " +
-              std::to_string(rf.header.size()) + " columns (column '" + rf.header[cells.size()] + "' missing)";
-    } else if (cells.size() > rf.header.size()) {
-      error = "line " + std::to_string(line_no) + ": " + std::to_string(cells.size()) + " cells for " +
-              std::to_string(rf.header.size()) + " columns";
-    }
-    std::vector<double> row(checked.size());
-    for (std::size_t k = 0; error.empty() && k < checked.size(); ++k) {
-      std::string why;
-      const auto v = parse_number(cells[checked[k].first], why);
-      if (!v) {
-        error = "line " + std::to_string(line_no) + ", column '" + checked[k].second + "' (#" +
-                std::to_string(checked[k].first + 1) + "): " + why;
-      } else {
-        row[k] = *v;
-      }
-    }
-    if (!error.empty()) {
-      if (!options.drop_bad_rows) throw fail(error);
-      ++rf.dropped_rows;
-      continue;
-    }
-    for (std::size_t k = 0; k < checked.size(); ++k) values[k].push_back(row[k]);
-    row_line.push_back(line_no);
+// The columns the parser keeps, as (index in the row, name), t first.
+using CheckedColumns = std::vector<std::pair<std::size_t, std::string>>;
+
+RunFileError failure(const std::string& name, const std::string& what) { return RunFileError(name + ": " + what); }
+
+// A line before the header: blank or a `# key: value` metadata line (kept);
+// false for the header itself.
+bool read_preamble_line(const std::string& line, RunFile& rf) {
+  const std::string tl = trim(line);
+  if (tl.empty()) return true;
+  if (tl[0] != '#') return false;
+  const std::string body = trim(tl.substr(1));
+  const auto colon = body.find(':');
+  if (colon != std::string::npos) rf.metadata.emplace_back(trim(body.substr(0, colon)), trim(body.substr(colon + 1)));
+  return true;
+}
+
+// The header row into rf.header, checked: t first, no name empty or twice,
+// every required column there. Returns the columns to keep.
+CheckedColumns read_header(const std::string& line, std::size_t line_no, const RunFileOptions& options, RunFile& rf,
+                           const std::string& name) {
+  const std::string where = "line " + std::to_string(line_no) + ": ";
+  rf.header = split(line);
+  if (rf.header.empty() || rf.header[0] != "t")
+    throw failure(name, where + "the first column must be 't' (found '" + (rf.header.empty() ? std::string() : rf.header[0]) + "')");
+  std::set<std::string> seen;
+  for (const auto& h : rf.header) {
+    if (h.empty()) throw failure(name, where + "empty column name in the header");
+    if (!seen.insert(h).second) throw failure(name, where + "duplicate column '" + h + "'");
   }
-  if (!have_header) throw fail("no header row (empty file or only metadata lines)");
-  const auto& t = values[0];
+  for (const auto& r : options.required)
+    if (!seen.count(r)) throw failure(name, "missing required column '" + r + "'");
+  const bool keep_all = options.required.empty() && options.optional.empty();
+  CheckedColumns checked;
+  for (std::size_t i = 0; i < rf.header.size(); ++i) {
+    const auto& h = rf.header[i];
+    const bool known = i == 0 || keep_all ||
+                       std::find(options.required.begin(), options.required.end(), h) != options.required.end() ||
+                       std::find(options.optional.begin(), options.optional.end(), h) != options.optional.end();
+    if (known) checked.emplace_back(i, h);
+  }
+  return checked;
+}
+
+// One data row's kept cells into `row`; returns why the row is bad, "" when it is good.
+std::string read_row(const std::string& line, std::size_t line_no, const std::vector<std::string>& header,
+                     const CheckedColumns& checked, std::vector<double>& row) {
+  const auto cells = split(line);
+  if (cells.size() < header.size()) {
+    return "line " + std::to_string(line_no) + ": short row, " + std::to_string(cells.size()) + " cells for " +
+           std::to_string(header.size()) + " columns (column '" + header[cells.size()] + "' missing)";
+  }
+  if (cells.size() > header.size()) {
+    return "line " + std::to_string(line_no) + ": " + std::to_string(cells.size()) + " cells for " +
+           std::to_string(header.size()) + " columns";
+  }
+  for (std::size_t k = 0; k < checked.size(); ++k) {
+    std::string why;
+    const auto v = parse_number(cells[checked[k].first], why);
+    if (!v) {
+      return "line " + std::to_string(line_no) + ", column '" + checked[k].second + "' (#" +
+             std::to_string(checked[k].first + 1) + "): " + why;
+    }
+    row[k] = *v;
+  }
+  return "";
+}
+
+// Enough rows, and a time span a double holds.
+void check_rows_and_span(const std::vector<double>& t, const RunFileOptions& options, const std::string& name) {
   const std::size_t n = t.size();
   if (n < std::max<std::size_t>(options.min_rows, 2))
-    throw fail("only " + std::to_string(n) + " data rows (at least " +
-               std::to_string(std::max<std::size_t>(options.min_rows, 2)) + " needed)");
+    throw failure(name, "only " + std::to_string(n) + " data rows (at least " +
+                            std::to_string(std::max<std::size_t>(options.min_rows, 2)) + " needed)");
   // Finite cells can still span more than a double holds (-1e308 .. 1e308):
   // the steps or the resampling grid would then be infinite.
   if (!std::isfinite(t.back() - t.front())) {
     std::ostringstream os;
     os << "time span from " << t.front() << " to " << t.back() << " s is too large for a double";
-    throw fail(os.str());
+    throw failure(name, os.str());
   }
+}
 
+// The median time step; throws at a step that does not increase, a gap or
+// irregular sampling. `jitter`: some step is off the median by over 1 %.
+double median_step(const std::vector<double>& t, const std::vector<std::size_t>& row_line, const std::string& name,
+                   bool& jitter) {
+  const std::size_t n = t.size();
   std::vector<double> steps(n - 1);
   for (std::size_t i = 1; i < n; ++i) {
     steps[i - 1] = t[i] - t[i - 1];
     if (!(steps[i - 1] > 0.0))
-      throw fail("line " + std::to_string(row_line[i]) + ": time does not increase (t = " + std::to_string(t[i]) +
-                 " after " + std::to_string(t[i - 1]) + ")");
+      throw failure(name, "line " + std::to_string(row_line[i]) + ": time does not increase (t = " + std::to_string(t[i]) +
+                              " after " + std::to_string(t[i - 1]) + ")");
   }
   std::vector<double> sorted = steps;
   std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
   const double dt = sorted[sorted.size() / 2];
-  bool jitter = false;
+  jitter = false;
   for (std::size_t i = 0; i < steps.size(); ++i) {
     const double r = steps[i] / dt;
     if (r > 1.5 || r < 0.5) {
@@ -219,17 +219,18 @@ RunFile parse_run_file(std::istream& in, const std::string& name, const RunFileO
       os << "line " << row_line[i + 1] << ": time step " << steps[i] << " s against the median " << dt
          << " s (" << (r > 1.5 ? "a gap: samples missing" : "irregular sampling")
          << "); split the run there or resample it";
-      throw fail(os.str());
+      throw failure(name, os.str());
     }
     if (std::abs(r - 1.0) > 0.01) jitter = true;
   }
-  rf.dt = dt;
-  if (!jitter) {
-    rf.t = t;
-    for (std::size_t k = 1; k < checked.size(); ++k) rf.columns[checked[k].second] = std::move(values[k]);
-    return rf;
-  }
-  // Jittered time stamps: linear interpolation onto the median grid.
+  return dt;
+}
+
+// Jittered time stamps: the columns linearly interpolated onto the grid of rf.dt.
+void resample_onto_grid(RunFile& rf, const std::vector<double>& t, const std::vector<std::vector<double>>& values,
+                        const CheckedColumns& checked) {
+  const std::size_t n = t.size();
+  const double dt = rf.dt;
   rf.resampled = true;
   const std::size_t m = static_cast<std::size_t>(std::floor((t.back() - t.front()) / dt + 1e-9)) + 1;
   rf.t.resize(m);
@@ -245,6 +246,51 @@ RunFile parse_run_file(std::istream& in, const std::string& name, const RunFileO
     }
     rf.columns[checked[k].second] = std::move(out);
   }
+}
+
+}  // namespace
+
+RunFile parse_run_file(std::istream& in, const std::string& name, const RunFileOptions& options) {
+  RunFile rf;
+  std::string line;
+  std::size_t line_no = 0;
+  bool have_header = false;
+  CheckedColumns checked;
+  std::vector<std::vector<double>> values;  // per checked column
+  std::vector<std::size_t> row_line;        // file line of each kept row
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line_no == 1 && line.size() >= 3 && line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3);
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (!have_header) {
+      if (read_preamble_line(line, rf)) continue;
+      checked = read_header(line, line_no, options, rf, name);
+      values.assign(checked.size(), {});
+      have_header = true;
+      continue;
+    }
+    if (trim(line).empty()) continue;  // a trailing blank line
+    std::vector<double> row(checked.size());
+    const std::string error = read_row(line, line_no, rf.header, checked, row);
+    if (!error.empty()) {
+      if (!options.drop_bad_rows) throw failure(name, error);
+      ++rf.dropped_rows;
+      continue;
+    }
+    for (std::size_t k = 0; k < checked.size(); ++k) values[k].push_back(row[k]);
+    row_line.push_back(line_no);
+  }
+  if (!have_header) throw failure(name, "no header row (empty file or only metadata lines)");
+  const auto& t = values[0];
+  check_rows_and_span(t, options, name);
+  bool jitter = false;
+  rf.dt = median_step(t, row_line, name, jitter);
+  if (jitter) {
+    resample_onto_grid(rf, t, values, checked);
+    return rf;
+  }
+  rf.t = t;
+  for (std::size_t k = 1; k < checked.size(); ++k) rf.columns[checked[k].second] = std::move(values[k]);
   return rf;
 }
 

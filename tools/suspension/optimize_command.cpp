@@ -225,56 +225,26 @@ void write_evaluation(std::ostream& js, const char* name, const DesignEvaluation
      << json_number(m.time_without_contact[1]) << "]\n  }" << tail << "\n";
 }
 
-}  // namespace
-
-OptimizeResult run_optimize(const OptimizeOptions& options, std::ostream& out, std::ostream& progress) {
-  const RigConfig config = load_rig_config(options.config_path, options.case_name);
-  if (config.rig != RigKind::kHalfCar) {
-    throw ConfigError(options.config_path + ": rig: `rigctl optimize` is for the half_car rig, this config is " +
-                      std::string(to_string(config.rig)));
-  }
-  OptimizeResult result;
-  result.settings = config.suspension_optimize;
-  auto& s = result.settings;
-  if (options.evaluations) {
-    if (*options.evaluations < 1) throw std::runtime_error("--evaluations must be at least 1");
-    s.evaluations = *options.evaluations;
-  }
-  // The initial design is the config's plant, and it must lie in the bounds.
+// The initial design, the config's plant, scaled to 0..1 within the
+// variables' bounds; a config value outside them is refused.
+std::vector<double> initial_design(const RigConfig& config, const SuspensionOptimizeConfig& s, const std::string& config_path) {
   std::vector<double> x0;
-  HalfCarParams initial_params = config.half_car;
+  HalfCarParams initial_params = config.half_car;  // field() reads through a mutable reference
   for (const auto& v : s.variables) {
     const double value = field(initial_params, v.name);
     if (value < v.min || value > v.max) {
-      throw ConfigError(options.config_path + ": " + plant_key(v.name) + ": the initial design " +
+      throw ConfigError(config_path + ": " + plant_key(v.name) + ": the initial design " +
                         json_number(value) + " is outside optimize.variables." + v.name + " [" + json_number(v.min) +
                         ", " + json_number(v.max) + "]");
     }
     x0.push_back((value - v.min) / (v.max - v.min));
   }
-  result.out_path = options.out_path.empty()
-                        ? (fs::path(config.telemetry.log_dir) /
-                           ("half_car-optimum" + (options.case_name.empty() ? "" : "-" + options.case_name) + ".json"))
-                              .string()
-                        : options.out_path;
+  return x0;
+}
 
-  out << "rigctl optimize: half_car from " << options.config_path
-      << (options.case_name.empty() ? "" : " case " + options.case_name) << ": " << s.algorithm << ", "
-      << s.evaluations << " evaluations of " << s.duration_s << " s (" << s.controller << " controller), seed "
-      << s.seed << "\n  cost = " << s.weight_comfort << " Wk/Wk0 + " << s.weight_tyre << " T/T0 + "
-      << s.weight_travel << " S/S0, peak |travel| <= " << s.travel_limit << " m\n";
-  out.flush();
-
-  Problem problem(config, s, progress, options.progress);
-  {
-    DesignEvaluation initial = problem.simulate(problem.physical(x0));
-    problem.set_reference(initial);
-    initial.cost = problem.weighted(initial);
-    problem.set_reference(initial);
-    result.initial = initial;
-    problem.offer(initial);
-  }
-
+// NLopt's search from x0 within the evaluation budget; the best feasible
+// design found stands whatever way the search ends.
+void search(Problem& problem, const SuspensionOptimizeConfig& s, const std::vector<double>& x0, OptimizeResult& result) {
   const auto n = static_cast<unsigned>(s.variables.size());
   nlopt::opt opt(s.algorithm == "isres" ? nlopt::GN_ISRES : nlopt::GN_CRS2_LM, n);
   nlopt::srand(static_cast<unsigned long>(s.seed));
@@ -298,8 +268,10 @@ OptimizeResult run_optimize(const OptimizeOptions& options, std::ostream& out, s
   problem.report(true);
   result.elapsed_s = problem.elapsed();
   result.best = problem.has_best() ? problem.best() : result.initial;
+}
 
-  // The summary.
+// The summary: the search's end, the variables and the metrics, initial beside optimum.
+void print_summary(const OptimizeResult& result, const SuspensionOptimizeConfig& s, std::ostream& out) {
   out << "  NLopt: " << result.nlopt_result << " after " << result.evaluations << " evaluations, "
       << std::fixed << std::setprecision(1) << result.elapsed_s << " s\n";
   out << "\n" << std::left << std::setw(12) << "variable" << std::right << std::setw(14) << "initial"
@@ -324,8 +296,10 @@ OptimizeResult run_optimize(const OptimizeOptions& options, std::ostream& out, s
   row("peak suspension travel [mm]", 1e3, result.initial.peak_travel, result.best.peak_travel, 2);
   row("peak body displacement [mm]", 1e3, result.initial.metrics.peak_z_s, result.best.metrics.peak_z_s, 3);
   row("peak body acceleration [m/s^2]", 1.0, result.initial.metrics.peak_acc, result.best.metrics.peak_acc, 3);
+}
 
-  // The file.
+// The optimum's JSON file (result.out_path).
+void write_optimum(const OptimizeResult& result, const OptimizeOptions& options, const SuspensionOptimizeConfig& s) {
   if (!fs::path(result.out_path).parent_path().empty()) fs::create_directories(fs::path(result.out_path).parent_path());
   std::ofstream js(result.out_path);
   if (!js) throw std::runtime_error(result.out_path + ": cannot create");
@@ -353,6 +327,49 @@ OptimizeResult run_optimize(const OptimizeOptions& options, std::ostream& out, s
   js << "}\n";
   js.close();
   if (!js) throw std::runtime_error(result.out_path + ": write failed");
+}
+
+}  // namespace
+
+OptimizeResult run_optimize(const OptimizeOptions& options, std::ostream& out, std::ostream& progress) {
+  const RigConfig config = load_rig_config(options.config_path, options.case_name);
+  if (config.rig != RigKind::kHalfCar) {
+    throw ConfigError(options.config_path + ": rig: `rigctl optimize` is for the half_car rig, this config is " +
+                      std::string(to_string(config.rig)));
+  }
+  OptimizeResult result;
+  result.settings = config.suspension_optimize;
+  auto& s = result.settings;
+  if (options.evaluations) {
+    if (*options.evaluations < 1) throw std::runtime_error("--evaluations must be at least 1");
+    s.evaluations = *options.evaluations;
+  }
+  const std::vector<double> x0 = initial_design(config, s, options.config_path);
+  result.out_path = options.out_path.empty()
+                        ? (fs::path(config.telemetry.log_dir) /
+                           ("half_car-optimum" + (options.case_name.empty() ? "" : "-" + options.case_name) + ".json"))
+                              .string()
+                        : options.out_path;
+
+  out << "rigctl optimize: half_car from " << options.config_path
+      << (options.case_name.empty() ? "" : " case " + options.case_name) << ": " << s.algorithm << ", "
+      << s.evaluations << " evaluations of " << s.duration_s << " s (" << s.controller << " controller), seed "
+      << s.seed << "\n  cost = " << s.weight_comfort << " Wk/Wk0 + " << s.weight_tyre << " T/T0 + "
+      << s.weight_travel << " S/S0, peak |travel| <= " << s.travel_limit << " m\n";
+  out.flush();
+
+  Problem problem(config, s, progress, options.progress);
+  {
+    DesignEvaluation initial = problem.simulate(problem.physical(x0));
+    problem.set_reference(initial);
+    initial.cost = problem.weighted(initial);
+    problem.set_reference(initial);
+    result.initial = initial;
+    problem.offer(initial);
+  }
+  search(problem, s, x0, result);
+  print_summary(result, s, out);
+  write_optimum(result, options, s);
   out << "\n  optimum: " << result.out_path << "\n";
   out.flush();
   return result;
