@@ -20,6 +20,7 @@
 #include "tools/iterate/road_target_command.hpp"
 #include "tools/tune/tune_command.hpp"
 #include "tools/runfile/log2csv.hpp"
+#include "tools/runfile/procedure_csv.hpp"
 #include "tools/runfile/log2mcap.hpp"
 #include "tools/procedure/rainflow_files.hpp"
 #include "tools/runfile/run_file_rig.hpp"
@@ -194,7 +195,7 @@ int main(int argc, char** argv) {
   // Authenticated operator commands (issue 7; tools/cmd/cmd_command.hpp).
   rigctl::CmdOptions opcmd;
   auto* opcmd_cmd = app.add_subcommand("cmd", "Send an authenticated operator command to a rig and wait for its acknowledgement (docs/operator-commands.md)");
-  opcmd_cmd->add_option("command", opcmd.command, "arm|start|hold|resume|stop|reset|hydraulics-low|hydraulics-high|hydraulics-off|setpoint")->required();
+  opcmd_cmd->add_option("command", opcmd.command, "arm|start|hold|resume|stop|reset|hydraulics-low|hydraulics-high|hydraulics-off|setpoint|stop-at-block-end (a running test procedure)")->required();
   opcmd_cmd->add_option("value", opcmd.value, "setpoint only: the new setpoint (SI units)");
   opcmd_cmd->add_option("--key", opcmd.key_path, "Key file shared with the rig (mode 600, at least 32 bytes)")->required();
   opcmd_cmd->add_option("--lcm-url", opcmd.lcm_url, "LCM URL of the rig network")->capture_default_str();
@@ -466,6 +467,11 @@ int main(int argc, char** argv) {
       std::cout << "log2csv: " << result.rows << " rows of " << result.rig << " written to " << csv_out;
       if (result.skipped > 0) std::cout << " (" << result.skipped << " incomplete ticks skipped)";
       std::cout << "\n";
+      // A procedure's counts beside it (docs/procedures.md).
+      const std::string proc_csv = rigctl::procedure_csv_path(csv_out);
+      if (const auto rows = rigctl::procedure_log_to_csv(log_in, proc_csv, prefix); rows > 0) {
+        std::cout << "log2csv: " << rows << " procedure rows written to " << proc_csv << "\n";
+      }
       return 0;
     }
   } catch (const rigctl::ConfigError& e) {

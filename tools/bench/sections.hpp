@@ -54,6 +54,7 @@ Section diagnosis_sweep_section();  // tools/bench/diagnosis.cpp
 Section scaling_section();    // tools/bench/scaling.cpp
 Section foxglove_section();   // tools/bench/foxglove.cpp
 Section foxglove_limits_section();  // tools/bench/foxglove_limits.cpp
+Section procedure_section();  // tools/bench/procedure.cpp
 
 Json skipped(const std::string& reason);
 

@@ -143,7 +143,7 @@ int run_cmd_command(const CmdOptions& o, std::ostream& out, std::ostream& err) {
   OperatorCommandKind kind{};
   if (!parse_command_name(name, kind)) {
     err << "rigctl cmd: unknown command '" << o.command
-        << "' (arm start hold resume stop reset hydraulics-low hydraulics-high hydraulics-off setpoint VALUE)\n";
+        << "' (arm start hold resume stop reset hydraulics-low hydraulics-high hydraulics-off setpoint VALUE stop-at-block-end)\n";
     return kCmdUsage;
   }
   double value = 0.0;

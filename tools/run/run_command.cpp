@@ -22,6 +22,7 @@
 #include "tools/run/console_station.hpp"
 #include "tools/run/console_status.hpp"
 #include "tools/runfile/log2csv.hpp"
+#include "tools/runfile/procedure_csv.hpp"
 #include "tools/run/loop_heartbeat.hpp"
 #include "tools/run/operator_mode.hpp"
 #include "foxglove/telemetry/telemetry_server.hpp"
@@ -282,7 +283,14 @@ RunReport run_rig(const RigConfig& config_file, const RunOptions& options, const
   } else if (!options.resume_path.empty()) {
     throw std::runtime_error("--resume continues a procedure: give its --procedure too");
   }
-  const TelemetryMeta meta = telemetry_meta_for(config, rig, loop_options, simulated_time);
+  TelemetryMeta meta = telemetry_meta_for(config, rig, loop_options, simulated_time);
+  if (procedure) {
+    for (const auto& step : procedure->spec.steps) {
+      meta.procedure_step_names.push_back(step.name);
+      meta.procedure_step_kinds.emplace_back(to_string(step.kind));
+    }
+    meta.procedure_cycles = procedure->spec.programmed_cycles();
+  }
   const std::string url = options.lcm_url.empty() ? config.telemetry.lcm_url : options.lcm_url;
   // Ten seconds of records: a paced run's publisher thread would have to
   // stall that long before the loop drops telemetry.
@@ -416,6 +424,11 @@ RunReport run_rig(const RigConfig& config_file, const RunOptions& options, const
     const auto csv =
         log_to_csv(report.log_path, report.csv_path, config.telemetry.channel_prefix, options.csv_truth_channels);
     out << "  csv: " << report.csv_path << " (" << csv.rows << " rows)\n";
+    if (procedure) {
+      const std::string proc_csv = procedure_csv_path(report.csv_path);
+      const auto rows = procedure_log_to_csv(report.log_path, proc_csv, config.telemetry.channel_prefix);
+      out << "  procedure csv: " << proc_csv << " (" << rows << " rows)\n";
+    }
   }
   out.flush();
   return report;
