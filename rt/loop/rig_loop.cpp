@@ -360,7 +360,7 @@ void RigLoop::emit(TelemetryRecord& record, bool with_timing) noexcept {
 RigLoop::Step RigLoop::decide_end(RunState& run) noexcept {
   const bool procedure_done = procedure_ != nullptr && procedure_->finished();
   if ((run.tick + 1 >= options_.max_ticks || procedure_done) && !run.run_length_reached) stop_at_run_length(run);
-  if (procedure_ != nullptr && !procedure_done && procedure_->stop_due()) stop_at_block_end(run);
+  if (procedure_ != nullptr && !procedure_done && procedure_->take_stop_due()) stop_at_block_end(run);
   // Operator mode ends when the operator has stopped the rig and then turned
   // the hydraulics off: the test is over and the rig is safe.
   const bool operator_done = !safety_.auto_sequence && run.operator_stopped && machine_.state() == SafetyState::kOff;

@@ -280,7 +280,6 @@ void ProcedureRunner::begin_end_level() noexcept {
 
 double ProcedureRunner::next(const Sample& sample, double feedback) noexcept {
   recovery_due_ = false;
-  stop_due_ = false;
   new_trip_ = Event{};
   if (!started_) start(feedback);
   double d = last_demand_;

@@ -66,12 +66,17 @@ class ProcedureRunner {
 
   // An operator's "stop at the end of the block": the procedure runs on to
   // the end of its present block (a block program's or a drive's pass, else
-  // the end of the step) and then says so once through stop_due(); the loop
+  // the end of the step) and then says so once through take_stop_due(); the loop
   // stops the rig there. The request is in the status (and the recovery)
   // until then.
   void request_stop_at_block_end() noexcept { state_.status.stop_at_block_end = true; }
-  // The block an operator asked to stop at ended on this tick.
-  bool stop_due() const noexcept { return stop_due_; }
+  // The block an operator asked to stop at has ended: true once (taken; a
+  // held or stopped rig does not ask the procedure, so nothing else clears it).
+  bool take_stop_due() noexcept {
+    const bool due = stop_due_;
+    stop_due_ = false;
+    return due;
+  }
 
   const ProcedureStatus& status() const noexcept { return state_.status; }
   // A cycle, a pass or a step ended on this tick: a recovery is due.

@@ -296,7 +296,7 @@ TEST(ProcedureRunner, StopAtBlockEndIsDueWhenThePresentPassEnds) {
       asked_at_cycles = runner.status().total_cycles;
       EXPECT_TRUE(runner.status().stop_at_block_end);
     }
-    if (runner.stop_due()) {
+    if (runner.take_stop_due()) {
       ++due_ticks;
       at_due = runner.status();
     }
