@@ -30,6 +30,7 @@
 #include "tools/run/rig_assembly.hpp"
 #include "tools/run/run_catalog.hpp"
 #include "tools/run/service_notify.hpp"
+#include "tools/procedure/capture_writer.hpp"
 #include "tools/procedure/procedure_run.hpp"
 
 namespace rigctl {
@@ -302,7 +303,16 @@ RunReport run_rig(const RigConfig& config_file, const RunOptions& options, const
   foxglove::StationDescription station = console_station(config, rig.driver->layout(), rig.setpoint_name);
   station.commands = operator_run && options.operator_commands == nullptr;  // the run's own receiver takes them
   const auto foxglove_server = make_foxglove_server(config, options, station);
+  // The procedure's data capture, fed by the publisher (declared before it,
+  // so that it outlives the publisher's thread).
+  std::unique_ptr<CaptureWriter> capture;
+  if (procedure && procedure->spec.capture.enabled) {
+    capture = std::make_unique<CaptureWriter>(report.log_path + ".capture", procedure->spec.capture, rig.driver->layout(),
+                                              meta.procedure_step_names, config.loop.period_s,
+                                              config.telemetry.channel_prefix);
+  }
   TelemetryPublisher publisher(meta, url, report.log_path, queue_capacity);
+  if (capture) publisher.add_tap(capture.get());
   for (TelemetryTap* tap : options.telemetry_taps) publisher.add_tap(tap);
   if (foxglove_server) publisher.add_tap(&foxglove_server->tap());
   Driver* driver = rig.driver.get();
@@ -412,6 +422,11 @@ RunReport run_rig(const RigConfig& config_file, const RunOptions& options, const
 
   print_run_summary(config, options, report, *rig.driver, out);
   if (procedure) print_procedure_summary(*procedure, out);
+  if (capture) {
+    capture->finish();  // the publisher has stopped: nothing more comes
+    out << "  capture: " << capture->folder() << " (" << capture->cycles_written() << " cycles' peaks, "
+        << capture->histories_written() << " cycle histories, " << capture->trips_written() << " trip windows)\n";
+  }
   print_run_records(report, publisher, events, receiver.get(), foxglove_server.get(), out);
   // A signal's stop is the operator's interruption; a trip that held or
   // stopped the rig made it faulted (rt/loop/rig_loop.cpp finish_run).
