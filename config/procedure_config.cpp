@@ -158,6 +158,24 @@ ProcedureSpec read_procedure(ConfigReader r, const std::string& name, const std:
     if (rf.has("reference_range")) spec.reference_range = rf.number("reference_range", 0.0);
     rf.reject_unknown_keys();
   }
+  if (r.has("capture")) {
+    auto c = r.child("capture");
+    spec.capture.enabled = true;
+    for (const auto& ch : c.has("channels") ? c.texts("channels") : std::vector<std::string>{}) {
+      const int i = ctx.layout->input_index(ch);
+      if (i < 0) c.fail("channels", "unknown channel '" + ch + "'");
+      spec.capture.channels.push_back(i);
+    }
+    if (spec.capture.channels.size() > 8) c.fail("channels", "at most 8 channels");
+    if (c.has("histories")) {
+      const std::string h = c.text("histories");
+      if (h != "log_spaced" && h != "none") c.fail("histories", "log_spaced or none, not '" + h + "'");
+      spec.capture.log_spaced_histories = h == "log_spaced";
+    }
+    if (c.has("pre_trigger")) spec.capture.pre_trigger_s = c.number("pre_trigger", 0.0, 60.0);
+    if (c.has("post_trigger")) spec.capture.post_trigger_s = c.number("post_trigger", 0.0, 60.0);
+    c.reject_unknown_keys();
+  }
   steps.read_steps(r, "", 0);
   r.reject_unknown_keys();
   return spec;

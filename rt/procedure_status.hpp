@@ -64,6 +64,16 @@ struct ProcedureStatus {
   double peak = 0.0;
   double valley = 0.0;
   double damage = 0.0;  // pseudo-damage of the first rainflow channel (committed)
+  // The peak-valley change detector's last cycle against its reference
+  // (fraction of the reference range; 0 until the reference is taken): its
+  // trend is the specimen's.
+  double pv_change = 0.0;
+  // Nominal time to the procedure's end [s] at the programmed frequencies
+  // and times: approaches, end-level ramps and holds by an operator not counted.
+  double time_left_s = 0.0;
+  // An operator asked to stop at the end of the present block (a block
+  // program's or a drive's pass, else the step); cleared when it stops.
+  bool stop_at_block_end = false;
 };
 
 }  // namespace rigctl

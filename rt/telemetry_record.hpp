@@ -68,6 +68,7 @@ enum class EventCode : uint8_t {
   // Test procedures (rt/procedure/procedure_runner.hpp).
   kPeakValleyChange,   // input `channel`'s peaks/valleys left the step's reference (value = change, fraction of range)
   kCompensationLimit,  // the compensation needed more than its max_factor (value = factor): something broke
+  kBlockEndStop,       // the block an operator asked to stop at has ended (value = test cycles done): a controlled stop
 };
 
 constexpr std::string_view to_string(EventCode c) {
@@ -95,6 +96,7 @@ constexpr std::string_view to_string(EventCode c) {
     case EventCode::kFaultReset: return "fault_reset";
     case EventCode::kPeakValleyChange: return "peak_valley_change";
     case EventCode::kCompensationLimit: return "compensation_limit";
+    case EventCode::kBlockEndStop: return "block_end_stop";
   }
   return "unknown";
 }

@@ -212,6 +212,75 @@ std::string schema_of(const rigctl::driver_status_t&) {
   return b.build("rigctl.DriverStatus", "The driver's I/O health, about once a second");
 }
 
+// --- procedure --------------------------------------------------------------
+
+std::string json_of(const rigctl::procedure_t& p) {
+  return Json{{kTimeColumn, p.t},
+              {"tick", p.tick},
+              {"step", p.step},
+              {"step_name", p.step_name},
+              {"step_kind", p.step_kind},
+              {"phase", p.phase},
+              {"step_cycles", p.step_cycles},
+              {"total_cycles", p.total_cycles},
+              {"programmed_cycles", p.programmed_cycles},
+              {"ramp_in_cycles", p.ramp_in_cycles},
+              {"row", p.row},
+              {"row_cycles", p.row_cycles},
+              {"pass", p.pass},
+              {"time_left", p.time_left},
+              {"wanted", p.wanted},
+              {"comp_gain", p.comp_gain},
+              {"comp_phase", p.comp_phase},
+              {"comp_mean", p.comp_mean},
+              {"comp_peak", p.comp_peak},
+              {"comp_valley", p.comp_valley},
+              {"amplitude_error", p.amplitude_error},
+              {"phase_error", p.phase_error},
+              {"peak_error", p.peak_error},
+              {"valley_error", p.valley_error},
+              {"peak", p.peak},
+              {"valley", p.valley},
+              {"pv_change", p.pv_change},
+              {"damage", p.damage},
+              {"stop_at_block_end", p.stop_at_block_end != 0}}
+      .dump();
+}
+
+std::string schema_of(const rigctl::procedure_t&) {
+  SchemaBuilder b;
+  b.time();
+  b.integer("tick", "loop tick");
+  b.integer("step", "index into the procedure's steps");
+  b.text("step_name", "the step's name: steps[i] or its name:");
+  b.text("step_kind", "ramp, hold, sine, blocks, drive");
+  b.text("phase", "approach, ramp_in, run, end_level, done");
+  b.integer("step_cycles", "test cycles done in the step");
+  b.integer("total_cycles", "test cycles done in the procedure");
+  b.integer("programmed_cycles", "test cycles the procedure programs in all");
+  b.integer("ramp_in_cycles", "cycles run to bring the amplitude in (not test cycles)");
+  b.integer("row", "blocks: the present row");
+  b.integer("row_cycles", "blocks: cycles done in the row");
+  b.integer("pass", "blocks, drive: passes done");
+  b.number("time_left", "s", "nominal time to the procedure's end");
+  b.number("wanted", "", "the programmed demand, in the feedback input's unit");
+  b.number("comp_gain", "", "amplitude_phase: command amplitude / wanted");
+  b.number("comp_phase", "rad", "amplitude_phase: command phase lead");
+  b.number("comp_mean", "", "amplitude_phase: command mean offset");
+  b.number("comp_peak", "", "peak_valley: commanded peak of the row");
+  b.number("comp_valley", "", "peak_valley: commanded valley of the row");
+  b.number("amplitude_error", "", "last measured cycle: fraction of the wanted amplitude");
+  b.number("phase_error", "rad", "last measured cycle");
+  b.number("peak_error", "", "peak_valley: last peak's error, fraction of the wanted range");
+  b.number("valley_error", "", "peak_valley: last valley's error, fraction of the wanted range");
+  b.number("peak", "", "the feedback's last peak");
+  b.number("valley", "", "the feedback's last valley");
+  b.number("pv_change", "", "peak-valley detector: last cycle against its reference, fraction of the range");
+  b.number("damage", "", "pseudo-damage of the first rainflow channel");
+  b.boolean("stop_at_block_end", "an operator asked to stop at the end of the present block");
+  return b.build("rigctl.Procedure", "A test procedure's step, counts, compensation and damage (docs/procedures.md)");
+}
+
 template <typename Msg>
 std::optional<TelemetryMessage> decode_as(const uint8_t* data, std::size_t size) {
   Msg m;
@@ -236,6 +305,7 @@ const std::string& TelemetryTopics::channel_of(TelemetryTopic topic) const {
     case TelemetryTopic::kTiming: return channels_.timing;
     case TelemetryTopic::kState: return channels_.state;
     case TelemetryTopic::kDriver: return channels_.driver;
+    case TelemetryTopic::kProcedure: return channels_.procedure;
   }
   return channels_.sample;
 }
@@ -248,6 +318,7 @@ std::string schema_name(TelemetryTopic topic) {
     case TelemetryTopic::kTiming: return "rigctl.Timing";
     case TelemetryTopic::kState: return "rigctl.State";
     case TelemetryTopic::kDriver: return "rigctl.DriverStatus";
+    case TelemetryTopic::kProcedure: return "rigctl.Procedure";
   }
   return "rigctl.Unknown";
 }
@@ -260,6 +331,7 @@ std::optional<TelemetryMessage> decode_telemetry(TelemetryTopic topic, const uin
     case TelemetryTopic::kTiming: return decode_as<rigctl::timing_t>(data, size);
     case TelemetryTopic::kState: return decode_as<rigctl::state_t>(data, size);
     case TelemetryTopic::kDriver: return decode_as<rigctl::driver_status_t>(data, size);
+    case TelemetryTopic::kProcedure: return decode_as<rigctl::procedure_t>(data, size);
   }
   return std::nullopt;
 }

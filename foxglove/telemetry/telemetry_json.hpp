@@ -14,6 +14,7 @@
 #include "rigctl/command_t.hpp"
 #include "rigctl/controller_t.hpp"
 #include "rigctl/driver_status_t.hpp"
+#include "rigctl/procedure_t.hpp"
 #include "rigctl/sample_t.hpp"
 #include "rigctl/state_t.hpp"
 #include "rigctl/timing_t.hpp"
@@ -21,13 +22,14 @@
 
 namespace rigctl::foxglove {
 
-enum class TelemetryTopic { kSample, kCommand, kController, kTiming, kState, kDriver };
-inline constexpr TelemetryTopic kTelemetryTopics[] = {TelemetryTopic::kSample, TelemetryTopic::kCommand,
+enum class TelemetryTopic { kSample, kCommand, kController, kTiming, kState, kDriver, kProcedure };
+inline constexpr TelemetryTopic kTelemetryTopics[] = {TelemetryTopic::kSample,    TelemetryTopic::kCommand,
                                                       TelemetryTopic::kController, TelemetryTopic::kTiming,
-                                                      TelemetryTopic::kState, TelemetryTopic::kDriver};
+                                                      TelemetryTopic::kState,     TelemetryTopic::kDriver,
+                                                      TelemetryTopic::kProcedure};
 
 using TelemetryMessage = std::variant<rigctl::sample_t, rigctl::command_t, rigctl::controller_t, rigctl::timing_t,
-                                      rigctl::state_t, rigctl::driver_status_t>;
+                                      rigctl::state_t, rigctl::driver_status_t, rigctl::procedure_t>;
 
 // The telemetry channels of one channel prefix (e.g. RIGCTL_SAMPLE).
 class TelemetryTopics {

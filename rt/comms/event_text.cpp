@@ -91,6 +91,8 @@ std::string event_message(const Event& ev, const ChannelLayout& layout) {
              action_suffix(ev);
     case EventCode::kCompensationLimit:
       return "compensation needed a factor " + format_g(ev.value) + ", beyond its limit: step stopped" + action_suffix(ev);
+    case EventCode::kBlockEndStop:
+      return "block ended after " + format_g(ev.value) + " test cycles: stopping as asked";
   }
   return "unknown event";
 }

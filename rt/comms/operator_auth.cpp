@@ -422,7 +422,7 @@ bool parse_command_name(std::string_view name, OperatorCommandKind& kind) {
   for (auto k : {OperatorCommandKind::kHydraulicsOff, OperatorCommandKind::kHydraulicsLow, OperatorCommandKind::kHydraulicsHigh,
                  OperatorCommandKind::kArm, OperatorCommandKind::kStart, OperatorCommandKind::kHold,
                  OperatorCommandKind::kResume, OperatorCommandKind::kStop, OperatorCommandKind::kReset,
-                 OperatorCommandKind::kSetpoint}) {
+                 OperatorCommandKind::kSetpoint, OperatorCommandKind::kStopAtBlockEnd}) {
     if (to_string(k) == name) {
       kind = k;
       return true;

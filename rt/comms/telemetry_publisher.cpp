@@ -237,7 +237,7 @@ void TelemetryPublisher::publish_procedure(const TelemetryRecord& r, int64_t uti
   const ProcedureStatus& s = r.procedure;
   const bool changed = s.total_cycles != last_procedure_.total_cycles || s.step != last_procedure_.step ||
                        s.phase != last_procedure_.phase || s.ramp_in_cycles != last_procedure_.ramp_in_cycles ||
-                       s.pass != last_procedure_.pass;
+                       s.pass != last_procedure_.pass || s.stop_at_block_end != last_procedure_.stop_at_block_end;
   if (!changed && r.tick % 40 != 0) return;
   last_procedure_ = s;
   rigctl::procedure_t m;
@@ -245,6 +245,9 @@ void TelemetryPublisher::publish_procedure(const TelemetryRecord& r, int64_t uti
   m.tick = r.tick;
   m.t = t;
   m.step = s.step;
+  const auto step = static_cast<std::size_t>(s.step);
+  m.step_name = step < meta_.procedure_step_names.size() ? meta_.procedure_step_names[step] : "";
+  m.step_kind = step < meta_.procedure_step_kinds.size() ? meta_.procedure_step_kinds[step] : "";
   m.phase = std::string(to_string(s.phase));
   m.step_cycles = s.step_cycles;
   m.total_cycles = s.total_cycles;
@@ -265,6 +268,10 @@ void TelemetryPublisher::publish_procedure(const TelemetryRecord& r, int64_t uti
   m.peak = s.peak;
   m.valley = s.valley;
   m.damage = s.damage;
+  m.pv_change = s.pv_change;
+  m.time_left = s.time_left_s;
+  m.programmed_cycles = meta_.procedure_cycles;
+  m.stop_at_block_end = s.stop_at_block_end;
   note_log_result(emit(*lcm_, log_.get(), taps_, channels_.procedure, utime, m));
 }
 

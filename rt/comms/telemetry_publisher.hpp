@@ -51,6 +51,10 @@ struct TelemetryMeta {
   // run of the same config give the same log apart from this offset, and
   // lcm-logplayer replays either at the rig's real speed.
   int64_t start_utime = 0;
+  // A test procedure's steps (their names and kinds, by index) and its
+  // programmed test cycles: RIGCTL_PROCEDURE names the present step.
+  std::vector<std::string> procedure_step_names, procedure_step_kinds;
+  int64_t procedure_cycles = 0;
 };
 
 // LCM channel names, given the prefix.

@@ -218,7 +218,9 @@ void RigLoop::take_commands(RunState& run) noexcept {
 // detectors, the controller and the profile, and its event.
 CommandResult RigLoop::apply_command(const OperatorCommand& c, EventSource source, bool log_refusal,
                                      RunState& run) noexcept {
-  const CommandResult r = machine_.apply(c);
+  // A request to the test procedure: without one there is no block to end.
+  const bool no_procedure = c.kind == OperatorCommandKind::kStopAtBlockEnd && procedure_ == nullptr;
+  const CommandResult r = no_procedure ? CommandResult{false, Rejection::kNoProcedure, false} : machine_.apply(c);
   if (r.accepted) on_accepted(c, source, r, run);
   if (r.accepted || log_refusal) log_command(c, source, r, run);
   events_.log_state_changes(machine_, run.tick, run.t_ns());  // the state change right after its command
@@ -243,6 +245,7 @@ void RigLoop::on_accepted(const OperatorCommand& c, EventSource source, const Co
       // A procedure continues its step from where the hold left the demand.
       if (procedure_ != nullptr) procedure_->start(run.previous_demand);
       break;
+    case OperatorCommandKind::kStopAtBlockEnd: procedure_->request_stop_at_block_end(); break;
     case OperatorCommandKind::kStart:
       run.operator_stopped = false;  // a new test after a re-arm
       if (procedure_ != nullptr) {
@@ -427,6 +430,7 @@ void RigLoop::emit(TelemetryRecord& record, bool with_timing) noexcept {
 RigLoop::Step RigLoop::decide_end(RunState& run) noexcept {
   const bool procedure_done = procedure_ != nullptr && procedure_->finished();
   if ((run.tick + 1 >= options_.max_ticks || procedure_done) && !run.run_length_reached) stop_at_run_length(run);
+  if (procedure_ != nullptr && !procedure_done && procedure_->take_stop_due()) stop_at_block_end(run);
   // Operator mode ends when the operator has stopped the rig and then turned
   // the hydraulics off: the test is over and the rig is safe.
   const bool operator_done = !safety_.auto_sequence && run.operator_stopped && machine_.state() == SafetyState::kOff;
@@ -448,6 +452,17 @@ RigLoop::Step RigLoop::decide_end(RunState& run) noexcept {
 void RigLoop::stop_at_run_length(RunState& run) noexcept {
   run.run_length_reached = true;
   commands_.run_ending();
+  if (machine_.valve_enabled()) apply_command(kStopCommand, EventSource::kAutomatic, true, run);
+}
+
+// The block an operator asked to stop at has ended: a controlled stop, as
+// the operator's own stop would be (in operator mode hydraulics off then
+// ends the run; a start continues the procedure with the next block).
+void RigLoop::stop_at_block_end(RunState& run) noexcept {
+  const Event e{EventCode::kBlockEndStop, -1, static_cast<double>(procedure_->status().total_cycles)};
+  events_.log(loop_event(run.tick, run.t_ns(), machine_.state(), e));
+  run.operator_stopped = true;
+  if (safety_.auto_sequence) commands_.run_ending();  // the automatic sequence does not start it again
   if (machine_.valve_enabled()) apply_command(kStopCommand, EventSource::kAutomatic, true, run);
 }
 

@@ -143,6 +143,7 @@ class RigLoop {
   double profile_value(RunState& run) noexcept;
   Event record_event(const RunState& run) const noexcept;
   void stop_at_run_length(RunState& run) noexcept;
+  void stop_at_block_end(RunState& run) noexcept;
   void emit(TelemetryRecord& record, bool with_timing) noexcept;
   double procedure_value(RunState& run) noexcept;
   void more_channel_demands(RunState& run) noexcept;

@@ -21,6 +21,26 @@ int64_t ticks_for(double distance, double rate, double period_s) noexcept {
 
 bool cyclic(StepKind k) noexcept { return k == StepKind::kSine || k == StepKind::kBlocks; }
 
+double rows_time_s(const StepSpec& s, std::size_t from_row) noexcept {
+  double t = 0.0;
+  for (std::size_t r = from_row; r < s.rows.size(); ++r) t += static_cast<double>(s.rows[r].cycles) / s.rows[r].frequency_hz;
+  return t;
+}
+
+// One step's nominal duration; a ramp at a rate counts 0 (its distance
+// depends on where it starts).
+double nominal_time_s(const StepSpec& s, double period_s) noexcept {
+  switch (s.kind) {
+    case StepKind::kRamp: return s.rate > 0.0 ? 0.0 : s.time_s;
+    case StepKind::kHold: return s.time_s;
+    case StepKind::kSine:  // and its ramp-in cycle (peak_valley has none)
+      return rows_time_s(s, 0) + (s.compensation.kind == Compensation::kPeakValley ? 0.0 : 1.0 / s.rows[0].frequency_hz);
+    case StepKind::kBlocks: return static_cast<double>(s.repeats) * rows_time_s(s, 0);
+    case StepKind::kDrive: return static_cast<double>(s.repeats) * static_cast<double>(s.drive.size()) * period_s;
+    default: return 0.0;
+  }
+}
+
 }  // namespace
 
 ProcedureRunner::ProcedureRunner(const ProcedureSpec& spec, double period_s, int feedback_input)
@@ -35,6 +55,34 @@ ProcedureRunner::ProcedureRunner(const ProcedureSpec& spec, double period_s, int
     }
     depth += s.kind == StepKind::kRepeatBegin ? 1 : (s.kind == StepKind::kRepeatEnd ? -1 : 0);
     if (depth > kMaxRepeatDepth) throw std::invalid_argument("procedure: repeats nested deeper than " + std::to_string(kMaxRepeatDepth));
+  }
+  // Nominal durations: each group's body from the innermost out (an end
+  // marker closes the innermost open group).
+  const std::size_t n = spec.steps.size();
+  step_time_s_.assign(n, 0.0);
+  body_time_s_.assign(n, 0.0);
+  group_end_.assign(n, static_cast<int>(n));
+  std::vector<int> open;
+  for (std::size_t i = 0; i < n; ++i) {
+    const StepSpec& s = spec.steps[i];
+    step_time_s_[i] = nominal_time_s(s, period_s);
+    if (s.kind == StepKind::kRepeatBegin) {
+      open.push_back(static_cast<int>(i));
+    } else if (s.kind == StepKind::kRepeatEnd && !open.empty()) {
+      const auto b = static_cast<std::size_t>(open.back());
+      open.pop_back();
+      group_end_[b] = static_cast<int>(i);
+      double body = 0.0;
+      for (std::size_t j = b + 1; j < i; ++j) {
+        if (spec.steps[j].kind == StepKind::kRepeatBegin) {
+          body += static_cast<double>(spec.steps[j].repeats) * body_time_s_[j];
+          j = static_cast<std::size_t>(group_end_[j]);
+        } else {
+          body += step_time_s_[j];
+        }
+      }
+      body_time_s_[b] = body;
+    }
   }
   state_.status.active = true;
   state_.rainflow_channels = static_cast<uint32_t>(spec.rainflow_channels.size());
@@ -66,6 +114,8 @@ void ProcedureRunner::restore(const ProcedureRecovery& r) noexcept {
     rainflow_[i].committed().set_data(res.committed);
   }
   started_ = true;  // the next start continues the recovered step
+  after_step_s_ = steps_after_s();
+  update_time_left();
 }
 
 void ProcedureRunner::recovery(ProcedureRecovery& out) noexcept {
@@ -151,6 +201,7 @@ void ProcedureRunner::enter_step(int index, double present) noexcept {
       state_.valley_command[r] = s.rows[r].mean - s.rows[r].amplitude;
     }
     ramp_tick_ = 0;
+    after_step_s_ = steps_after_s();
     if (s.kind == StepKind::kRamp || s.kind == StepKind::kHold) {
       st.phase = ProcedurePhase::kRun;
     } else {
@@ -208,6 +259,7 @@ void ProcedureRunner::begin_cyclic() noexcept {
 
 void ProcedureRunner::finish_step() noexcept {
   recovery_due_ = true;
+  block_ended();
   if (step().has_end_level) {
     begin_end_level();
     return;
@@ -259,6 +311,7 @@ double ProcedureRunner::next(const Sample& sample, double feedback) noexcept {
     if (t == Tick::kDemand) break;
   }
   if (state_.status.phase != ProcedurePhase::kDone) count_rainflow(sample);
+  update_time_left();
   last_demand_ = d;
   return d;
 }
@@ -330,6 +383,7 @@ ProcedureRunner::Tick ProcedureRunner::drive_tick(double& d) noexcept {
     ++st.step_cycles;
     ++st.total_cycles;
     recovery_due_ = true;
+    block_ended();
     if (st.pass >= s.repeats) {
       finish_step();
       return Tick::kMoved;
@@ -432,7 +486,9 @@ bool ProcedureRunner::close_cycle() noexcept {
   st.row_cycles = 0;
   if (++st.row < static_cast<int32_t>(sp.rows.size())) return false;
   st.row = 0;
-  return ++st.pass >= sp.repeats;
+  ++st.pass;
+  block_ended();
+  return st.pass >= sp.repeats;
 }
 
 // ---- blocks: valley -> peak -> valley, haversine halves between end levels
@@ -542,6 +598,7 @@ void ProcedureRunner::check_peak_valley(double peak, double valley) noexcept {
   }
   const double range = std::max(ref.peak - ref.valley, 1e-12);
   const double change = std::max(std::fabs(peak - ref.peak), std::fabs(valley - ref.valley)) / range;
+  state_.status.pv_change = change;
   ref.out_of_tolerance = change > d.tolerance ? ref.out_of_tolerance + 1 : 0;
   if (ref.out_of_tolerance == d.cycles) trip(EventCode::kPeakValleyChange, d.channel, change, d.action);
 }
@@ -556,6 +613,74 @@ void ProcedureRunner::count_rainflow(const Sample& s) noexcept {
     rainflow_[i].push(s.value[static_cast<std::size_t>(spec_.rainflow_channels[i])]);
   }
   if (!spec_.rainflow_channels.empty()) state_.status.damage = rainflow_[0].committed().damage();
+}
+
+// ---- operator requests and time left
+
+void ProcedureRunner::block_ended() noexcept {
+  if (!state_.status.stop_at_block_end) return;
+  state_.status.stop_at_block_end = false;  // the recovery written at this end has it done
+  stop_due_ = true;
+}
+
+void ProcedureRunner::update_time_left() noexcept {
+  state_.status.time_left_s =
+      state_.status.phase == ProcedurePhase::kDone ? 0.0 : present_step_left_s() + after_step_s_;
+}
+
+double ProcedureRunner::present_step_left_s() const noexcept {
+  const ProcedureStatus& st = state_.status;
+  const StepSpec& s = step();
+  const auto ticks_s = [&](int64_t ticks) { return static_cast<double>(std::max<int64_t>(ticks, 0)) * period_s_; };
+  if (st.phase == ProcedurePhase::kEndLevel) return ticks_s(ramp_ticks_ - ramp_tick_);
+  const bool running = st.phase == ProcedurePhase::kRun || st.phase == ProcedurePhase::kRampIn;
+  const double in_cycle = running ? cycle_phase_ : 0.0;
+  switch (s.kind) {
+    case StepKind::kRamp: return s.rate > 0.0 ? 0.0 : std::max(0.0, s.time_s - ticks_s(st.step_ticks));
+    case StepKind::kHold: return std::max(0.0, s.time_s - ticks_s(st.step_ticks));
+    case StepKind::kSine: {
+      const BlockRow& r = s.rows[0];
+      const double cycles = static_cast<double>(r.cycles - st.step_cycles) + (st.phase == ProcedurePhase::kRampIn ? 1.0 : 0.0);
+      return std::max(0.0, (cycles - in_cycle) / r.frequency_hz);
+    }
+    case StepKind::kBlocks: {
+      const BlockRow& r = row();
+      const double in_row = std::max(0.0, (static_cast<double>(r.cycles - st.row_cycles) - in_cycle) / r.frequency_hz);
+      return in_row + rows_time_s(s, row_index() + 1) +
+             static_cast<double>(std::max<int64_t>(s.repeats - st.pass - 1, 0)) * rows_time_s(s, 0);
+    }
+    case StepKind::kDrive:
+      return ticks_s((s.repeats - st.pass) * static_cast<int64_t>(s.drive.size()) - (running ? st.step_ticks : 0));
+    default: return 0.0;
+  }
+}
+
+// The steps after the present one: the rest of every open repeat group
+// (its passes still to come) and everything after it.
+double ProcedureRunner::steps_after_s() const noexcept {
+  const ProcedureStatus& st = state_.status;
+  const int n = static_cast<int>(spec_.steps.size());
+  double t = 0.0;
+  int depth = st.repeat_depth;
+  for (int j = st.step + 1; j < n;) {
+    const StepSpec& s = spec_.steps[static_cast<std::size_t>(j)];
+    if (s.kind == StepKind::kRepeatBegin) {
+      t += static_cast<double>(s.repeats) * body_time_s_[static_cast<std::size_t>(j)];
+      j = group_end_[static_cast<std::size_t>(j)] + 1;
+      continue;
+    }
+    if (s.kind == StepKind::kRepeatEnd && depth > 0) {
+      const auto top = static_cast<std::size_t>(depth - 1);
+      const auto begin = static_cast<std::size_t>(st.repeat_begin[top]);
+      const int64_t more = spec_.steps[begin].repeats - st.repeat_done[top] - 1;
+      t += static_cast<double>(std::max<int64_t>(more, 0)) * body_time_s_[begin];
+      --depth;
+    } else {
+      t += step_time_s_[static_cast<std::size_t>(j)];
+    }
+    ++j;
+  }
+  return t;
 }
 
 }  // namespace rigctl

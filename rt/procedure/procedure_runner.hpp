@@ -26,6 +26,7 @@
 
 #include <array>
 #include <cstdint>
+#include <vector>
 
 #include "rt/procedure/procedure_spec.hpp"
 #include "rt/procedure/procedure_state.hpp"
@@ -63,6 +64,20 @@ class ProcedureRunner {
   }
   void clear_latch() noexcept { action_ = LimitAction::kNone; }
 
+  // An operator's "stop at the end of the block": the procedure runs on to
+  // the end of its present block (a block program's or a drive's pass, else
+  // the end of the step) and then says so once through take_stop_due(); the loop
+  // stops the rig there. The request is in the status (and the recovery)
+  // until then.
+  void request_stop_at_block_end() noexcept { state_.status.stop_at_block_end = true; }
+  // The block an operator asked to stop at has ended: true once (taken; a
+  // held or stopped rig does not ask the procedure, so nothing else clears it).
+  bool take_stop_due() noexcept {
+    const bool due = stop_due_;
+    stop_due_ = false;
+    return due;
+  }
+
   const ProcedureStatus& status() const noexcept { return state_.status; }
   // A cycle, a pass or a step ended on this tick: a recovery is due.
   bool recovery_due() const noexcept { return recovery_due_; }
@@ -97,6 +112,13 @@ class ProcedureRunner {
   void trip(EventCode code, int channel, double value, LimitAction action) noexcept;
   void track_cycle_extremes(const Sample& s, double feedback) noexcept;
   void count_rainflow(const Sample& s) noexcept;
+  // A block (pass or step) ended: a requested stop is due.
+  void block_ended() noexcept;
+  // Nominal time left: the present step's from its counts, plus the steps
+  // after it (after_step_s_, walked when a step begins).
+  void update_time_left() noexcept;
+  double present_step_left_s() const noexcept;
+  double steps_after_s() const noexcept;
   const StepSpec& step() const noexcept { return spec_.steps[static_cast<std::size_t>(state_.status.step)]; }
   const BlockRow& row() const noexcept { return step().rows[static_cast<std::size_t>(state_.status.row)]; }
   std::size_t row_index() const noexcept { return static_cast<std::size_t>(state_.status.row); }
@@ -132,7 +154,14 @@ class ProcedureRunner {
   LimitAction action_ = LimitAction::kNone;
   Event new_trip_{};
   bool recovery_due_ = false;
+  bool stop_due_ = false;
   uint64_t sequence_ = 0;
+  // Nominal durations, built before the run: each step's (a repeat marker's
+  // is 0), each repeat group's body once, and where each group ends.
+  std::vector<double> step_time_s_;
+  std::vector<double> body_time_s_;
+  std::vector<int> group_end_;
+  double after_step_s_ = 0.0;
 };
 
 }  // namespace rigctl

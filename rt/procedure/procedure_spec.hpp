@@ -112,6 +112,17 @@ struct StepSpec {
   bool has_end_level = false;
 };
 
+// Data capture (docs/procedures.md, "Capture"): written off the tick by
+// tools/procedure/capture_writer.hpp from the telemetry the tick already
+// hands over; the runner never looks at it.
+struct CaptureSpec {
+  bool enabled = false;
+  std::vector<int> channels;         // input indices: their peak and valley every test cycle
+  bool log_spaced_histories = true;  // full-rate histories of each step's cycles 1, 2, 5, 10, 20, 50, ...
+  double pre_trigger_s = 0.5;        // around every trip: this long before
+  double post_trigger_s = 0.5;       // and this long after
+};
+
 struct ProcedureSpec {
   std::string path;       // the file it came from
   std::string hash;       // FNV-1a of its bytes, hex: a recovery file names the procedure it belongs to
@@ -122,6 +133,7 @@ struct ProcedureSpec {
   std::vector<int> rainflow_channels;
   double basquin_exponent = 5.0;
   double reference_range = 0.0;  // 0: the first programmed amplitude's range
+  CaptureSpec capture;
   // Total test cycles the procedure programs (sine and block cycles, drive
   // passes), repeats included.
   int64_t programmed_cycles() const;

@@ -20,6 +20,7 @@ enum class OperatorCommandKind : uint8_t {
   kStop,            // controlled stop: ramp to hold, then disarm
   kReset,           // edge-triggered fault reset; succeeds only once every fault has cleared
   kSetpoint,        // change the held setpoint to `value` (SI), within the configured limits
+  kStopAtBlockEnd,  // a test procedure runs on to the end of its present block, then a controlled stop
 };
 
 struct OperatorCommand {
@@ -40,6 +41,7 @@ constexpr std::string_view to_string(OperatorCommandKind k) {
     case OperatorCommandKind::kStop: return "stop";
     case OperatorCommandKind::kReset: return "reset";
     case OperatorCommandKind::kSetpoint: return "setpoint";
+    case OperatorCommandKind::kStopAtBlockEnd: return "stop_at_block_end";
   }
   return "unknown";
 }

@@ -12,39 +12,40 @@ constexpr TransitionRule no(R why) { return {false, S::kFaulted, Guard::kNone, w
 
 // Every command in every state, in one place. Columns follow
 // OperatorCommandKind: hyd_off, hyd_low, hyd_high, arm, start, hold, resume,
-// stop, reset, setpoint. A reset outside `faulted` keeps the state and
+// stop, reset, setpoint, stop_at_block_end (a request to a running or held
+// test procedure: the state stays; the procedure's block end stops the rig). A reset outside `faulted` keeps the state and
 // clears the latches of trips whose condition has gone.
 constexpr TransitionRule kTransitions[kSafetyStateCount][kOperatorCommandKindCount] = {
     // off
     {no(R::kAlreadyInState), go(S::kHydraulicsLow), no(R::kHydraulicsOff), no(R::kNotHighPressure),
      no(R::kNotArmed), no(R::kNotRunning), no(R::kNotHolding), no(R::kNotDriven), go(S::kOff, Guard::kFaultsClear),
-     no(R::kNotDriven)},
+     no(R::kNotDriven), no(R::kNotRunning)},
     // hydraulics_low
     {go(S::kOff), no(R::kAlreadyInState), go(S::kHydraulicsHigh, Guard::kLowPressure), no(R::kNotHighPressure),
      no(R::kNotArmed), no(R::kNotRunning), no(R::kNotHolding), no(R::kNotDriven),
-     go(S::kHydraulicsLow, Guard::kFaultsClear), no(R::kNotDriven)},
+     go(S::kHydraulicsLow, Guard::kFaultsClear), no(R::kNotDriven), no(R::kNotRunning)},
     // hydraulics_high
     {go(S::kOff), go(S::kHydraulicsLow), no(R::kAlreadyInState), go(S::kArmed, Guard::kReadyToArm), no(R::kNotArmed),
      no(R::kNotRunning), no(R::kNotHolding), no(R::kNotDriven), go(S::kHydraulicsHigh, Guard::kFaultsClear),
-     no(R::kNotDriven)},
+     no(R::kNotDriven), no(R::kNotRunning)},
     // armed: stop disarms at once (the demand is already a hold at rest)
     {no(R::kValveDriven), no(R::kValveDriven), no(R::kAlreadyInState), no(R::kAlreadyInState),
      go(S::kRunning, Guard::kReadyToRun), no(R::kNotRunning), no(R::kNotHolding), go(S::kHydraulicsHigh),
-     go(S::kArmed, Guard::kFaultsClear), go(S::kArmed, Guard::kSetpointInRange)},
+     go(S::kArmed, Guard::kFaultsClear), go(S::kArmed, Guard::kSetpointInRange), no(R::kNotRunning)},
     // running
     {no(R::kValveDriven), no(R::kValveDriven), no(R::kAlreadyInState), no(R::kAlreadyInState),
      no(R::kAlreadyInState), go(S::kHolding), no(R::kNotHolding), go(S::kStopping),
-     go(S::kRunning, Guard::kFaultsClear), no(R::kNotHolding)},
+     go(S::kRunning, Guard::kFaultsClear), no(R::kNotHolding), go(S::kRunning)},
     // holding
     {no(R::kValveDriven), no(R::kValveDriven), no(R::kAlreadyInState), no(R::kAlreadyInState), no(R::kUseResume),
      no(R::kAlreadyInState), go(S::kRunning, Guard::kReadyToRun), go(S::kStopping),
-     go(S::kHolding, Guard::kFaultsClear), go(S::kHolding, Guard::kSetpointInRange)},
+     go(S::kHolding, Guard::kFaultsClear), go(S::kHolding, Guard::kSetpointInRange), go(S::kHolding)},
     // stopping: nothing interrupts a controlled stop but a fault
     {no(R::kStopping), no(R::kStopping), no(R::kStopping), no(R::kStopping), no(R::kStopping), no(R::kStopping),
-     no(R::kStopping), no(R::kStopping), no(R::kStopping), no(R::kStopping)},
+     no(R::kStopping), no(R::kStopping), no(R::kStopping), no(R::kStopping), no(R::kStopping)},
     // faulted: only a reset, and only with every fault gone
     {no(R::kFaulted), no(R::kFaulted), no(R::kFaulted), no(R::kFaulted), no(R::kFaulted), no(R::kFaulted),
-     no(R::kFaulted), no(R::kFaulted), go(S::kOff, Guard::kFaultsClear), no(R::kFaulted)},
+     no(R::kFaulted), no(R::kFaulted), go(S::kOff, Guard::kFaultsClear), no(R::kFaulted), no(R::kFaulted)},
 };
 
 constexpr bool valve_driven(S s) {
@@ -75,6 +76,7 @@ std::string_view to_string(Rejection r) {
     case R::kNotDriven: return "the valve is not driven (arm first)";
     case R::kStopping: return "a controlled stop is in progress";
     case R::kSetpointOutOfRange: return "setpoint outside the configured range";
+    case R::kNoProcedure: return "no test procedure runs";
   }
   return "unknown";
 }

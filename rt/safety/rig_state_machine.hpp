@@ -29,7 +29,7 @@
 
 namespace rigctl {
 
-inline constexpr std::size_t kOperatorCommandKindCount = 10;
+inline constexpr std::size_t kOperatorCommandKindCount = 11;
 
 // Why a command was refused. Codes on the loop; to_string off it.
 enum class Rejection : uint8_t {
@@ -51,8 +51,9 @@ enum class Rejection : uint8_t {
   kNotDriven,           // stop/setpoint need the valve driven (armed, running or holding)
   kStopping,            // a controlled stop is in progress
   kSetpointOutOfRange,  // setpoint not finite or outside the configured range
+  kNoProcedure,         // stop_at_block_end: no test procedure runs (the loop refuses it, not the table)
 };
-inline constexpr std::size_t kRejectionCount = 18;
+inline constexpr std::size_t kRejectionCount = 19;
 
 std::string_view to_string(Rejection r);
 

@@ -82,7 +82,7 @@ void check_decoded(const DecodedCommand& d) {
 // known name picked by the length byte).
 operator_command_t command_from(fuzz::Reader& in) {
   static const char* const kNames[] = {"arm", "start", "hold", "resume", "stop", "reset", "hydraulics_low",
-                                       "hydraulics_high", "hydraulics_off", "setpoint"};
+                                       "hydraulics_high", "hydraulics_off", "setpoint", "stop_at_block_end"};
   operator_command_t msg{};
   const uint8_t flags = in.u8();
   msg.version = (flags & 1) ? 2 : kOperatorWireVersion;
@@ -97,7 +97,7 @@ operator_command_t command_from(fuzz::Reader& in) {
   if (flags & 0x10) msg.value = (static_cast<int>(in.u8()) - 128) * 0.001;
   msg.sender = take_string(in, 80);
   if (flags & 0x20) {
-    msg.command = kNames[in.u8() % 10];
+    msg.command = kNames[in.u8() % (sizeof kNames / sizeof kNames[0])];
   } else {
     msg.command = take_string(in, 40);
   }

@@ -13,6 +13,9 @@
 //   client are answered and survived; a console that disconnects right
 //   after a command frees control; the first console stops the rig (S key).
 // trip: a run whose x_r is at its rail: the trips and the detector table.
+// procedure: a run of a block program (rigctl run --procedure): the procedure
+//   panel counts; hold, resume and "stop at block end" from the page, the
+//   request shown until the block ends and the rig stops there.
 "use strict";
 const fs = require("fs");
 const os = require("os");
@@ -213,6 +216,46 @@ async function tripScenario(browser, args, result, log) {
   await a.screenshot({ path: path.join(args.screenshots, "trip.png"), fullPage: true });
 }
 
+const procedureTotal = (page) => page.$eval("#procedure-cycles", (e) => Number(e.dataset.total || -1));
+
+async function procedureScenario(browser, args, result, log) {
+  const a = await openConsole(browser, args.url, log);
+  await setField(a, "#sender", "alice");
+  await setField(a, "#key", args.key);
+  await a.click("#take-control");
+  result.takeControl = await answer(a, "take_control");
+  await driveToRunning(a, result);
+  // The panel appears with the first RIGCTL_PROCEDURE message and counts.
+  await a.waitForFunction(() => !document.getElementById("procedure-panel").hidden &&
+                                Number(document.getElementById("procedure-cycles").dataset.total) >= 2, POLL);
+  await a.click('#command-buttons button[data-command="hold"]');
+  result.hold = await answer(a, "hold");
+  await waitState(a, "holding");
+  result.cyclesAtHold = await procedureTotal(a);
+  await a.click('#command-buttons button[data-command="resume"]');
+  result.resume = await answer(a, "resume");
+  await waitState(a, "running");
+  await a.waitForFunction((n) => Number(document.getElementById("procedure-cycles").dataset.total) > n, POLL, result.cyclesAtHold);
+  // Every message the page renders from here: was the request shown?
+  await a.evaluate(() => {
+    window.sawStopRequest = false;
+    const render = rigctl.procedure.render;
+    rigctl.procedure.render = (m) => { if (m.stop_at_block_end) window.sawStopRequest = true; render(m); };
+  });
+  result.cyclesAtRequest = await procedureTotal(a);
+  await a.click('#command-buttons button[data-command="stop_at_block_end"]');
+  result.stopAtBlockEnd = await answer(a, "stop_at_block_end");
+  await waitState(a, "hydraulics_high");
+  result.sawStopRequest = await a.evaluate(() => window.sawStopRequest);
+  result.requestAfterStop = await a.$eval("#procedure-request", (e) => e.dataset.stopAtBlockEnd);
+  // The last messages of the stop reach the page after the state: wait for the count to settle on a pass.
+  result.cyclesAtStop = await procedureTotal(a);
+  result.panel = await a.$$eval("#procedure tr", (rows) => rows.map((r) => r.textContent.trim().replace(/\s+/g, " ")));
+  await (await a.$("#procedure-panel")).screenshot({ path: path.join(args.screenshots, "procedure.png") });
+  await a.click('#command-buttons button[data-command="hydraulics_off"]');
+  result.hydraulicsOff = await answer(a, "hydraulics_off");
+}
+
 async function main() {
   const args = parseArgs(process.argv);
   fs.mkdirSync(args.screenshots, { recursive: true });
@@ -221,6 +264,7 @@ async function main() {
   let code = 0;
   try {
     if (args.scenario === "trip") await tripScenario(browser, args, result, result.log);
+    else if (args.scenario === "procedure") await procedureScenario(browser, args, result, result.log);
     else await commandsScenario(browser, args, result, result.log);
   } catch (e) {
     result.error = String(e && e.stack || e);

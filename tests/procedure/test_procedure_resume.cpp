@@ -6,14 +6,15 @@
 // programmed count; each killed segment's run log must read to its end
 // with no tick missing.
 //
-// The issue asks for 100 kills; each segment starts a process, assembles the
-// rig and ramps back in, which on the shared 2-core test machine costs about
-// a second: kKills below is what the test time allows (the number is said
-// in docs/procedures.md).
+// 100 kills, as the issue asks. Each kill comes from the procedure's
+// progress: the segment is killed the moment its recovery file reaches a
+// random target cycle (20-80 cycles after the previous kill), no sleep
+// picks it. 36 s on the shared 2-core machine at load 9 (docs/procedures.md).
 #include <gtest/gtest.h>
 
 #include <lcm/lcm-cpp.hpp>
 #include <signal.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <filesystem>
@@ -30,7 +31,7 @@ using namespace rigctl;
 
 namespace {
 
-constexpr int kKills = 20;
+constexpr int kKills = 100;
 constexpr int64_t kCycles = 10000;
 
 struct LogFacts {
@@ -73,7 +74,8 @@ int64_t recovered_cycles(const std::string& path) {
 }  // namespace
 
 TEST(ProcedureResume, KilledAtRandomMomentsAndResumedCountsEveryCycleOnce) {
-  const auto dir = std::filesystem::path(::testing::TempDir()) / "procedure-resume";
+  // The pid in the name: two test runs on one machine (two worktrees) must not share it.
+  const auto dir = std::filesystem::path(::testing::TempDir()) / ("procedure-resume-" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   const std::string proc = (dir / "proc.yaml").string(), recovery = (dir / "run.recovery").string();
@@ -86,8 +88,7 @@ TEST(ProcedureResume, KilledAtRandomMomentsAndResumedCountsEveryCycleOnce) {
   std::mt19937 rng(30);
   // Kill targets about half-way through the count in all: the last segment
   // still has thousands of cycles to run.
-  std::uniform_int_distribution<int64_t> step(50, kCycles / kKills - 50);
-  std::uniform_int_distribution<int> extra_ms(0, 20);
+  std::uniform_int_distribution<int64_t> step(20, kCycles / kKills - 20);
   int64_t target = 0;
   std::vector<int64_t> killed_at;
   for (int segment = 0;; ++segment) {
@@ -109,7 +110,6 @@ TEST(ProcedureResume, KilledAtRandomMomentsAndResumedCountsEveryCycleOnce) {
         if (!reached) std::this_thread::sleep_for(std::chrono::microseconds(200));
       }
       ASSERT_TRUE(reached) << "segment " << segment << " never reached cycle " << target << ":\n" << p.output();
-      std::this_thread::sleep_for(std::chrono::milliseconds(extra_ms(rng)));
       ASSERT_GT(p.pid(), 0) << "segment " << segment << " ended before its kill:\n" << p.output();
       kill(p.pid(), SIGKILL);
       p.wait();

@@ -24,6 +24,7 @@
 #include "read_file.hpp"
 #include "state_changes.hpp"
 #include "test_netns.hpp"
+#include "tools/procedure/recovery_file.hpp"
 #include "wait_until.hpp"
 
 namespace fs = std::filesystem;
@@ -165,6 +166,76 @@ TEST_F(OperatorMode, CommandsDriveTheRigThroughEveryStateAndEndIt) {
   const std::string ev = read_file(events_);
   EXPECT_EQ(state_changes(ev), expected) << ev;
   EXPECT_NE(ev.find("# closed cleanly"), std::string::npos) << ev;
+}
+
+// A test procedure commanded by `rigctl cmd` (issue 30): hold and resume
+// it, and "stop at the end of the block": a block program of 4-cycle passes
+// stops at a whole pass, its recovery says so, and a resume from that
+// recovery continues with the next pass.
+TEST_F(OperatorMode, AProcedureIsHeldResumedAndStoppedAtItsBlockEndByRigctlCmd) {
+  const std::string proc = (dir_ / "proc.yaml").string(), recovery = (dir_ / "run.recovery").string();
+  std::ofstream(proc) << "ramp_rate: 0.02\n"
+                         "steps:\n"
+                         "  - blocks:\n"
+                         "      repeats: 100000\n"
+                         "      rows:\n"
+                         "        - {mean: 0.08, amplitude: 0.004, frequency: 2.0, cycles: 2}\n"
+                         "        - {mean: 0.085, amplitude: 0.006, frequency: 2.0, cycles: 2}\n";
+  BackgroundProcess rig({"/bin/sh", "-c",
+                         "exec " + in_ns(kRigctl + " run " + config_ + " --operator --key " + key_ + " --lcm-url '" +
+                                         kUrl + "' --log " + (dir_ / "run.lcm").string() + " --no-realtime --procedure " +
+                                         proc + " --recovery " + recovery)},
+                        (dir_ / "rig.out").string());
+  ASSERT_TRUE(rig.wait_for("listening on RIGCTL_OPERATOR", 60.0)) << rig.output();
+  auto step = [&](const std::string& command, const std::string& change) {
+    const auto r = cmd(command, key_);
+    ASSERT_EQ(r.exit_code, 0) << command << ": " << r.output;
+    ASSERT_TRUE(wait_event(change)) << command << " did not give " << change << "\n" << read_file(events_) << rig.output();
+  };
+  auto cycles = [&] { return rigctl::read_recovery_file(recovery).recovery.status; };
+  step("reset", "message=\"faulted -> off\"");
+  step("hydraulics-low", "message=\"off -> hydraulics_low\"");
+  step("hydraulics-high", "message=\"hydraulics_low -> hydraulics_high\"");
+  // Not running yet: refused by the state table, with its reason.
+  step("stop-at-block-end", "message=\"stop_at_block_end refused: the rig is not running\"");
+  step("arm", "message=\"hydraulics_high -> armed\"");
+  step("start", "message=\"armed -> running\"");
+  ASSERT_TRUE(rigctl::test::wait_until([&] { return fs::exists(recovery) && cycles().total_cycles >= 1; }, 120.0))
+      << rig.output();
+  step("hold", "message=\"running -> holding\"");
+  step("resume", "message=\"holding -> running\"");
+  const int64_t before = cycles().total_cycles;
+  ASSERT_TRUE(rigctl::test::wait_until([&] { return cycles().total_cycles > before; }, 120.0)) << rig.output();
+  step("stop-at-block-end", "message=\"stop_at_block_end accepted\"");
+  ASSERT_TRUE(wait_event("code=block_end_stop")) << read_file(events_);
+  ASSERT_TRUE(wait_event("message=\"stopping -> hydraulics_high\"")) << read_file(events_);
+  step("hydraulics-off", "message=\"hydraulics_high -> off\"");
+  EXPECT_EQ(rig.wait(), 0) << rig.output();
+
+  // Stopped at a whole pass; the recovery has the request done.
+  const rigctl::ProcedureStatus at_stop = cycles();
+  EXPECT_EQ(at_stop.total_cycles % 4, 0) << at_stop.total_cycles;
+  EXPECT_GT(at_stop.total_cycles, before);
+  EXPECT_EQ(at_stop.row, 0);
+  EXPECT_EQ(at_stop.row_cycles, 0);
+  EXPECT_FALSE(at_stop.stop_at_block_end);
+  const std::string ev = read_file(events_);
+  EXPECT_NE(ev.find("code=block_end_stop value=" + std::to_string(at_stop.total_cycles) + " "), std::string::npos) << ev;
+  const auto changes = state_changes(ev);
+  const std::vector<std::string> tail{"armed -> running", "running -> holding", "holding -> running", "running -> stopping",
+                                      "stopping -> hydraulics_high", "hydraulics_high -> off"};
+  ASSERT_GE(changes.size(), tail.size()) << ev;
+  EXPECT_EQ(std::vector<std::string>(changes.end() - static_cast<std::ptrdiff_t>(tail.size()), changes.end()), tail) << ev;
+
+  // Resumed from that recovery (simulated time, 10 s): no stop at the next
+  // block end, the count goes on from the stop's.
+  const auto resumed = run_command(kRigctl + " run " + config_ + " --fast --duration 10 --procedure " + proc +
+                                   " --resume " + recovery + " --log " + (dir_ / "resumed.lcm").string() +
+                                   " --recovery " + (dir_ / "resumed.recovery").string());
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
+  const rigctl::ProcedureStatus after = rigctl::read_recovery_file((dir_ / "resumed.recovery").string()).recovery.status;
+  EXPECT_GE(after.total_cycles, at_stop.total_cycles + 4) << resumed.output;
+  EXPECT_EQ(read_file((dir_ / "resumed.lcm.events").string()).find("block_end_stop"), std::string::npos);
 }
 
 TEST(OperatorModeConfig, WithoutAKeyTheRunRefusesNamingTheField) {

@@ -25,7 +25,7 @@ namespace {
 
 std::vector<Section> all_sections() {
   return {timing_section(), plant_section(), io_section(), diagnosis_section(), diagnosis_sweep_section(),
-          scaling_section(), channels_section(), foxglove_section(), foxglove_limits_section()};
+          scaling_section(), channels_section(), foxglove_section(), foxglove_limits_section(), procedure_section()};
 }
 
 std::string utc_now() {

@@ -55,6 +55,7 @@ Section scaling_section();    // tools/bench/scaling.cpp
 Section channels_section();   // tools/bench/channels.cpp
 Section foxglove_section();   // tools/bench/foxglove.cpp
 Section foxglove_limits_section();  // tools/bench/foxglove_limits.cpp
+Section procedure_section();  // tools/bench/procedure.cpp
 
 Json skipped(const std::string& reason);
 

@@ -152,7 +152,7 @@ bool read_command(const CmdOptions& o, CommandToSend& c, std::ostream& err) {
   std::replace(c.name.begin(), c.name.end(), '-', '_');
   if (!parse_command_name(c.name, c.kind)) {
     err << "rigctl cmd: unknown command '" << o.command
-        << "' (arm start hold resume stop reset hydraulics-low hydraulics-high hydraulics-off setpoint VALUE)\n";
+        << "' (arm start hold resume stop reset hydraulics-low hydraulics-high hydraulics-off setpoint VALUE stop-at-block-end)\n";
     return false;
   }
   if (c.kind == OperatorCommandKind::kSetpoint) {

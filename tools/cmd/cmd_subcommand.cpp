@@ -12,7 +12,7 @@ class CmdSubcommand final : public Subcommand {
  public:
   CLI::App& add_to(CLI::App& program) override {
     auto* c = program.add_subcommand("cmd", "Send an authenticated operator command to a rig and wait for its acknowledgement (docs/operator-commands.md)");
-    c->add_option("command", options_.command, "arm|start|hold|resume|stop|reset|hydraulics-low|hydraulics-high|hydraulics-off|setpoint")->required();
+    c->add_option("command", options_.command, "arm|start|hold|resume|stop|reset|hydraulics-low|hydraulics-high|hydraulics-off|setpoint|stop-at-block-end (a running test procedure)")->required();
     c->add_option("value", options_.value, "setpoint only: the new setpoint (SI units)");
     c->add_option("--key", options_.key_path, "Key file shared with the rig (mode 600, at least 32 bytes)")->required();
     c->add_option("--lcm-url", options_.lcm_url, "LCM URL of the rig network")->capture_default_str();

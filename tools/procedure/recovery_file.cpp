@@ -57,7 +57,7 @@ void write_recovery_file(const std::string& path, const RecoveryIdentity& id, co
        << "\nconfig: " << id.config_path << "\nconfig_hash: " << id.config_hash << "\nsequence: " << r.sequence
        << "\nstep: " << s.step << "\nphase: " << to_string(s.phase) << "\nstep_cycles: " << s.step_cycles
        << "\ntotal_cycles: " << s.total_cycles << "\nramp_in_cycles: " << s.ramp_in_cycles << "\nrow: " << s.row
-       << "\npass: " << s.pass << "\nbytes: " << sizeof r << "\nchecksum: " << std::hex << fnv1a(bytes, sizeof r)
+       << "\nrow_cycles: " << s.row_cycles << "\npass: " << s.pass << "\nbytes: " << sizeof r << "\nchecksum: " << std::hex << fnv1a(bytes, sizeof r)
        << std::dec << "\n---\n";
   std::string out = head.str();
   out.append(bytes, sizeof r);

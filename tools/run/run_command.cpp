@@ -11,6 +11,8 @@
 #include "config/config_reader.hpp"
 #include "rt/realtime.hpp"
 #include "tools/common/stage_text.hpp"
+#include "tools/runfile/procedure_csv.hpp"
+#include "tools/procedure/capture_writer.hpp"
 #include "tools/procedure/procedure_run.hpp"
 #include "tools/run/console_status.hpp"
 #include "tools/run/operator_mode.hpp"
@@ -138,6 +140,16 @@ LoopResult run_loop(RunPlan& plan, const RunOptions& options, RunServices& servi
   return loop.run(stop);
 }
 
+// The procedure's data capture, finished once the publisher has stopped
+// (nothing more comes).
+void print_capture_summary(RunServices& services, std::ostream& out) {
+  CaptureWriter* capture = services.capture();
+  if (capture == nullptr) return;
+  capture->finish();
+  out << "  capture: " << capture->folder() << " (" << capture->cycles_written() << " cycles' peaks, "
+      << capture->histories_written() << " cycle histories, " << capture->trips_written() << " trip windows)\n";
+}
+
 // A signal's stop is the operator's interruption; a trip that held or
 // stopped the rig made it faulted (rt/loop/rig_loop.cpp finish_run).
 catalog::EndReason catalog_end_reason(const LoopResult& result, const std::atomic<bool>& stop) {
@@ -177,12 +189,18 @@ RunReport run_rig(const RigConfig& config_file, const RunOptions& options, const
 
   print_run_summary(plan.config, options, report, *plan.rig.driver, out);
   if (services.procedure()) print_procedure_summary(*services.procedure(), out);
+  print_capture_summary(services, out);
   print_run_records(report, services, out);
   services.finish_in_catalog(catalog_end_reason(report.loop, stop), report.end_reason);
   report.catalog_run_id = services.catalog_run_id();
   if (!report.csv_path.empty()) {
     const auto csv = log_to_csv(report.log_path, report.csv_path, plan.config.telemetry.channel_prefix, options.csv_truth_channels);
     out << "  csv: " << report.csv_path << " (" << csv.rows << " rows)\n";
+    if (services.procedure()) {
+      const std::string proc_csv = procedure_csv_path(report.csv_path);
+      const auto rows = procedure_log_to_csv(report.log_path, proc_csv, plan.config.telemetry.channel_prefix);
+      out << "  procedure csv: " << proc_csv << " (" << rows << " rows)\n";
+    }
   }
   out.flush();
   return report;

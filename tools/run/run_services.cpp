@@ -29,12 +29,29 @@ ProcedureRunOptions procedure_options_for(const RunOptions& options, const RunPl
 
 // --procedure: the test procedure read for the assembled rig (and its
 // recovery, on --resume); nullptr without one.
-std::unique_ptr<ProcedureRun> open_procedure(const ProcedureRunOptions& po, const RunOptions& options, const RunPlan& plan) {
+std::unique_ptr<ProcedureRun> open_procedure(const ProcedureRunOptions& po, const RunOptions& options, RunPlan& plan) {
   if (po.procedure_path.empty()) {
     if (!options.resume_path.empty()) throw std::runtime_error("--resume continues a procedure: give its --procedure too");
     return nullptr;
   }
-  return open_procedure_run(po, plan.rig.driver->layout(), std::max(0, plan.rig.safety.feedback_input));
+  auto procedure = open_procedure_run(po, plan.rig.driver->layout(), std::max(0, plan.rig.safety.feedback_input));
+  // The run's header names the steps and the programmed cycles
+  // (RIGCTL_PROCEDURE's readers: the console, Foxglove, log2csv).
+  TelemetryMeta& meta = plan.records.meta;
+  for (const auto& step : procedure->spec.steps) {
+    meta.procedure_step_names.push_back(step.name);
+    meta.procedure_step_kinds.emplace_back(to_string(step.kind));
+  }
+  meta.procedure_cycles = procedure->spec.programmed_cycles();
+  return procedure;
+}
+
+// The procedure's data capture (docs/procedures.md), when its file asks for one.
+std::unique_ptr<CaptureWriter> make_capture(const ProcedureRun* procedure, const RunPlan& plan) {
+  if (procedure == nullptr || !procedure->spec.capture.enabled) return nullptr;
+  return std::make_unique<CaptureWriter>(plan.records.log_path + ".capture", procedure->spec.capture,
+                                         plan.rig.driver->layout(), plan.records.meta.procedure_step_names,
+                                         plan.config.loop.period_s, plan.config.telemetry.channel_prefix);
 }
 
 // The Foxglove server of the run, when the config or --ws asks for one.
@@ -62,6 +79,7 @@ RunServices::RunServices(const RunOptions& options, RunPlan& plan)
       plan_(plan),
       procedure_options_(procedure_options_for(options, plan)),
       procedure_(open_procedure(procedure_options_, options, plan)),
+      capture_(make_capture(procedure_.get(), plan)),
       server_(make_foxglove_server(options, plan)),
       publisher_(plan.records.meta, plan.records.lcm_url, plan.records.log_path, plan.records.queue_capacity),
       // Every state change, trip and command, fsync'd per line.
@@ -70,6 +88,7 @@ RunServices::RunServices(const RunOptions& options, RunPlan& plan)
       operator_commands_(options.operator_commands),
       heartbeat_(publisher_),
       notifier_(heartbeat_.beats()) {
+  if (capture_) publisher_.add_tap(capture_.get());
   for (TelemetryTap* tap : options.telemetry_taps) publisher_.add_tap(tap);
   if (server_) publisher_.add_tap(&server_->tap());
   Driver* driver = plan.rig.driver.get();

@@ -14,6 +14,8 @@
 // destructor.
 #pragma once
 
+#include "tools/procedure/capture_writer.hpp"
+
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -71,6 +73,7 @@ class RunServices {
   const CommandReceiver* receiver() const { return receiver_.get(); }
   const ProcedureRun* procedure() const { return procedure_.get(); }
   const ProcedureRunOptions& procedure_options() const { return procedure_options_; }
+  CaptureWriter* capture() { return capture_.get(); }  // the procedure's data capture, or null
   int64_t catalog_run_id() const { return catalog_ ? catalog_->id() : 0; }
 
  private:
@@ -82,6 +85,9 @@ class RunServices {
   RunPlan& plan_;
   ProcedureRunOptions procedure_options_;
   std::unique_ptr<ProcedureRun> procedure_;
+  // Fed by the publisher: declared before it, so that it outlives the
+  // publisher's thread.
+  std::unique_ptr<CaptureWriter> capture_;
   std::unique_ptr<foxglove::TelemetryServer> server_;
   TelemetryPublisher publisher_;
   EventLog events_;

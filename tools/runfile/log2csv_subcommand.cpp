@@ -3,6 +3,7 @@
 
 #include "tools/cli/subcommand.hpp"
 #include "tools/runfile/log2csv.hpp"
+#include "tools/runfile/procedure_csv.hpp"
 
 namespace rigctl::cli {
 
@@ -23,6 +24,10 @@ class Log2CsvSubcommand final : public Subcommand {
     invocation.out << "log2csv: " << result.rows << " rows of " << result.rig << " written to " << csv_path_;
     if (result.skipped > 0) invocation.out << " (" << result.skipped << " incomplete ticks skipped)";
     invocation.out << "\n";
+    // A procedure's counts beside it (docs/procedures.md).
+    const std::string procedure_csv = procedure_csv_path(csv_path_);
+    if (const auto rows = procedure_log_to_csv(log_path_, procedure_csv, prefix_); rows > 0)
+      invocation.out << "log2csv: " << rows << " procedure rows written to " << procedure_csv << "\n";
     return 0;
   }
 

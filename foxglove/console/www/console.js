@@ -4,7 +4,8 @@
 
 (() => {
   const $ = (id) => document.getElementById(id);
-  const COMMANDS = ["reset", "hydraulics_low", "hydraulics_high", "arm", "start", "hold", "resume", "stop", "hydraulics_off"];
+  const COMMANDS = ["reset", "hydraulics_low", "hydraulics_high", "arm", "start", "hold", "resume", "stop", "hydraulics_off",
+                    "stop_at_block_end"];
   const COMMAND_TOPIC = "/rigctl/console/command";
   const scope = new rigctl.Scope($("scope"));
   const page = {
@@ -86,6 +87,7 @@
       case "rigctl.Timing": page.timing = m; rigctl.station.renderTiming(page.timing, page.driver); break;
       case "rigctl.DriverStatus": page.driver = m; rigctl.station.renderTiming(page.timing, page.driver); break;
       case "rigctl.ConsoleAnswer": showAnswer(m); break;
+      case "rigctl.Procedure": rigctl.procedure.render(m); break;
     }
   }
 
@@ -127,7 +129,7 @@
       for (const c of COMMANDS) {
         const b = document.createElement("button");
         b.type = "button";
-        b.textContent = c.replace("_", " ");
+        b.textContent = c.replaceAll("_", " ");
         b.dataset.command = c;
         b.onclick = () => send(c);
         box.append(b);

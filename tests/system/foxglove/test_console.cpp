@@ -14,7 +14,10 @@
 #include <sstream>
 #include <string>
 
+#include <lcm/lcm-cpp.hpp>
+
 #include "background_process.hpp"
+#include "rigctl/procedure_t.hpp"
 #include "config_edit.hpp"
 #include "node_client.hpp"
 #include "process.hpp"
@@ -175,6 +178,82 @@ TEST_F(Console, ALimitTripShowsItsDetectorAndTheRefusedReset) {
   const std::string events = read_file(path("run.lcm.events"));
   EXPECT_GE(count_lines(events, "reset refused: a fault is still present"), 1) << events;
   EXPECT_EQ(state_changes(events).size(), 0u) << events;  // never left faulted
+}
+
+// A block program of 4-cycle passes (two rows of two 2 Hz cycles: 2 s a
+// pass), long enough to outlast the browser: the console's hold, resume and
+// "stop at the end of the block" on a running procedure.
+TEST_F(Console, AProcedureIsShownAndHeldResumedAndStoppedAtItsBlockEnd) {
+  std::ofstream(path("proc.yaml")) << "ramp_rate: 0.02\n"
+                                      "steps:\n"
+                                      "  - blocks:\n"
+                                      "      repeats: 100000\n"
+                                      "      rows:\n"
+                                      "        - {mean: 0.08, amplitude: 0.004, frequency: 2.0, cycles: 2}\n"
+                                      "        - {mean: 0.085, amplitude: 0.006, frequency: 2.0, cycles: 2}\n";
+  const int port = free_tcp_port();
+  auto rig = start_rig(port, {"--procedure", path("proc.yaml")});
+  const auto r = run_browser(port, "procedure");
+  // Hydraulics off after the stop ends the run by itself (the deadline is for a run that does not).
+  rig->wait_until([](const std::string&) { return false; }, kStartTimeoutS);
+  ASSERT_EQ(rig->stop(), 0) << rig->output();
+  ASSERT_FALSE(r.contains("error")) << r.dump(2);
+  for (const char* answer : {"takeControl", "hold", "resume", "stopAtBlockEnd", "hydraulicsOff"}) {
+    EXPECT_EQ(r[answer]["reason"], "accepted") << answer << ": " << r[answer];
+  }
+  // The page showed the request until the block ended, then not.
+  EXPECT_TRUE(r["sawStopRequest"].get<bool>()) << r.dump(2);
+  EXPECT_EQ(r["requestAfterStop"], "false");
+  EXPECT_GT(r["cyclesAtStop"].get<int>(), r["cyclesAtHold"].get<int>());
+
+  // The event log: the commands, the block end and the stop after it.
+  const std::string events = read_file(path("run.lcm.events"));
+  for (const char* line : {"message=\"hold accepted\"", "message=\"resume accepted\"",
+                           "message=\"stop_at_block_end accepted\"", "code=block_end_stop"}) {
+    EXPECT_EQ(count_lines(events, line), 1) << line << "\n" << events;
+  }
+  const auto changes = state_changes(events);
+  const std::vector<std::string> tail = {"armed -> running", "running -> holding", "holding -> running",
+                                         "running -> stopping", "stopping -> hydraulics_high", "hydraulics_high -> off"};
+  ASSERT_GE(changes.size(), tail.size()) << events;
+  EXPECT_EQ(std::vector<std::string>(changes.end() - static_cast<std::ptrdiff_t>(tail.size()), changes.end()), tail) << events;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(events, m, std::regex(R"(tick=(\d+) state=running code=block_end_stop value=(\d+))"))) << events;
+  const long stop_tick = std::stol(m[1]);
+  const long stopped_at = std::stol(m[2]);
+  EXPECT_EQ(stopped_at % 4, 0) << "the stop came mid-pass: " << stopped_at;
+  ASSERT_TRUE(std::regex_search(events, m, std::regex(R"(tick=(\d+) state=holding code=state_changed[^\n]*running -> holding)")))
+      << events;
+  const long hold_tick = std::stol(m[1]);
+  ASSERT_TRUE(std::regex_search(events, m, std::regex(R"(tick=(\d+) state=running code=state_changed[^\n]*holding -> running)")))
+      << events;
+  const long resume_tick = std::stol(m[1]);
+
+  // RIGCTL_PROCEDURE in the run log: no cycle counted while held, the
+  // request on from its command to the block end, nothing counted after.
+  lcm::LogFile log(path("run.lcm"), "r");
+  ASSERT_TRUE(log.good());
+  int64_t held_cycles = -1, last_total = -1, messages = 0, requested = 0;
+  while (const lcm::LogEvent* e = log.readNextEvent()) {
+    if (e->channel != "RIGCTL_PROCEDURE") continue;
+    rigctl::procedure_t p;
+    ASSERT_GE(p.decode(e->data, 0, e->datalen), 0);
+    ++messages;
+    EXPECT_EQ(p.step_kind, "blocks");
+    EXPECT_EQ(p.programmed_cycles, 400000);
+    if (p.tick > hold_tick + 100 && p.tick < resume_tick) {  // the hold's ramp has ended its half-cycle
+      if (held_cycles < 0) held_cycles = p.total_cycles;
+      EXPECT_EQ(p.total_cycles, held_cycles) << "counted while held, tick " << p.tick;
+    }
+    if (p.stop_at_block_end) {
+      ++requested;
+      EXPECT_LE(p.tick, stop_tick);
+    }
+    last_total = p.total_cycles;
+  }
+  EXPECT_GT(messages, 50);
+  EXPECT_GT(requested, 0);
+  EXPECT_EQ(last_total, stopped_at);
 }
 
 }  // namespace

@@ -133,6 +133,35 @@ TEST_F(Log2Mcap, ATruncatedLogGivesWhatWasReadableAndAWarning) {
   EXPECT_LT(log.total, read_log(path("run.lcm")).total);
 }
 
+// A run of a test procedure: RIGCTL_PROCEDURE goes into the MCAP with the
+// other channels, every message valid against its schema (rigctl.Procedure).
+TEST_F(Log2Mcap, AProcedureRunsChannelGoesInWithTheOthers) {
+  const auto run = run_command(kRigctl + " run " + kConfig + " --fast --procedure " + std::string(RIGCTL_SOURCE_DIR) +
+                               "/config/quarter_car_procedure.yaml --duration 12 --log " + path("proc.lcm"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const LogContents log = read_log(path("proc.lcm"));
+  ASSERT_GT(log.counts.count("RIGCTL_PROCEDURE"), 0u) << "no procedure messages in the run log";
+  const auto r = convert_and_read(path("proc.lcm"), path("proc.mcap"));
+  expect_matches_log(r, log);
+  EXPECT_EQ(r["channels"]["RIGCTL_PROCEDURE"]["schemaName"], "rigctl.Procedure");
+
+  // log2csv: the run file, and the procedure's messages beside it, one row each.
+  const auto csv = run_command(kRigctl + " log2csv " + path("proc.lcm") + " " + path("proc.csv"));
+  ASSERT_EQ(csv.exit_code, 0) << csv.output;
+  std::ifstream in(path("proc.procedure.csv"));
+  ASSERT_TRUE(in.good()) << csv.output;
+  std::string header, line, last;
+  std::getline(in, header);
+  EXPECT_EQ(header.rfind("t,tick,step,step_name,step_kind,phase,step_cycles,total_cycles,", 0), 0u) << header;
+  int64_t rows = 0;
+  while (std::getline(in, line)) {
+    ++rows;
+    last = line;
+  }
+  EXPECT_EQ(rows, log.counts.at("RIGCTL_PROCEDURE"));
+  EXPECT_NE(last.find("\"steps[1]\",sine,"), std::string::npos) << last;  // 12 s: still in the sine step
+}
+
 TEST_F(Log2Mcap, AFileThatIsNoLcmLogIsAnErrorNamingIt) {
   std::ofstream(path("notes.txt")) << "not a log\n";
   const auto r = run_command(kRigctl + " log2mcap " + path("notes.txt") + " " + path("out.mcap"));

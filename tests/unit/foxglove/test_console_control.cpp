@@ -277,7 +277,7 @@ TEST(Station, TheCommandTableIsTheStateMachines) {
   EXPECT_EQ(j["states"]["faulted"]["start"]["allowed"], false);
   EXPECT_FALSE(j["states"]["faulted"]["start"]["refused"].get<std::string>().empty());
   EXPECT_EQ(j["states"].size(), 8u);
-  EXPECT_EQ(j["states"]["off"].size(), 10u);
+  EXPECT_EQ(j["states"]["off"].size(), 11u);  // every operator command, stop_at_block_end included
 }
 
 }  // namespace

@@ -92,14 +92,15 @@ TEST(OperatorVerifier, ValidCommandsAreAcceptedAndCounted) {
                             std::pair{"hydraulics_off", OperatorCommandKind::kHydraulicsOff},
                             std::pair{"start", OperatorCommandKind::kStart}, std::pair{"hold", OperatorCommandKind::kHold},
                             std::pair{"resume", OperatorCommandKind::kResume}, std::pair{"stop", OperatorCommandKind::kStop},
-                            std::pair{"reset", OperatorCommandKind::kReset}}) {
+                            std::pair{"reset", OperatorCommandKind::kReset},
+                            std::pair{"stop_at_block_end", OperatorCommandKind::kStopAtBlockEnd}}) {
     static int64_t seq = 10;
     const auto b = signed_bytes(command(name, ++seq), key);
     const DecodedCommand r = v.verify(b.data(), b.size(), kNow);
     EXPECT_TRUE(r.ok()) << name << ": " << r.detail;
     EXPECT_EQ(r.command.kind, kind) << name;
   }
-  EXPECT_EQ(v.counters().accepted(), 10u);
+  EXPECT_EQ(v.counters().accepted(), 11u);
   EXPECT_EQ(v.counters().rejected(), 0u);
 }
 

@@ -259,3 +259,98 @@ TEST(ProcedureRunner, PeakValleyChangeTripsWithItsAction) {
   EXPECT_GT(trip_cycle, 155);
   EXPECT_LT(trip_cycle, 172);
 }
+
+namespace {
+
+StepSpec blocks(std::vector<BlockRow> rows, int64_t repeats) {
+  StepSpec b;
+  b.kind = StepKind::kBlocks;
+  b.name = "blocks";
+  b.rows = std::move(rows);
+  b.repeats = repeats;
+  return b;
+}
+
+}  // namespace
+
+// "Stop at the end of the block" asked mid-pass: the procedure says so on
+// the tick its pass ends (never earlier, once), with the request cleared
+// (the recovery written there does not stop again) and the counts at a
+// whole pass.
+TEST(ProcedureRunner, StopAtBlockEndIsDueWhenThePresentPassEnds) {
+  ProcedureSpec spec;
+  spec.steps.push_back(blocks({{0.0, 0.01, 4.0, 3}, {0.0, 0.02, 2.0, 2}}, 5));
+  ProcedureRunner runner(spec, kTs, 0);
+  LagPlant plant;
+  Sample s;
+  runner.start(plant.y);
+  int64_t due_ticks = 0, asked_at_cycles = -1;
+  ProcedureStatus at_due;
+  for (int64_t k = 0; k < 1000000 && !runner.finished(); ++k) {
+    s.value[0] = plant.y;
+    const double u = runner.next(s, plant.y);
+    plant.step(u);
+    // Asked in the second pass's second row.
+    if (asked_at_cycles < 0 && runner.status().pass == 1 && runner.status().row == 1) {
+      runner.request_stop_at_block_end();
+      asked_at_cycles = runner.status().total_cycles;
+      EXPECT_TRUE(runner.status().stop_at_block_end);
+    }
+    if (runner.take_stop_due()) {
+      ++due_ticks;
+      at_due = runner.status();
+    }
+  }
+  ASSERT_GE(asked_at_cycles, 0);
+  EXPECT_EQ(due_ticks, 1);
+  EXPECT_EQ(at_due.pass, 2);
+  EXPECT_EQ(at_due.row, 0);
+  EXPECT_EQ(at_due.row_cycles, 0);
+  EXPECT_EQ(at_due.total_cycles, 10);  // two passes of 5 cycles
+  EXPECT_FALSE(at_due.stop_at_block_end);
+  EXPECT_EQ(runner.status().total_cycles, 25);  // the loop, not the runner, stops the rig
+}
+
+// The time left: the programme's nominal length at the start, falling by a
+// tick's period each tick of a test cycle, 0 at the end; repeat groups and
+// the steps after them counted.
+TEST(ProcedureRunner, TimeLeftCountsDownThroughRepeatsAndSteps) {
+  ProcedureSpec spec;
+  StepSpec rep;
+  rep.kind = StepKind::kRepeatBegin;
+  rep.repeats = 2;
+  spec.steps.push_back(rep);
+  spec.steps.push_back(sine(0.0, 0.01, 5.0, 10, Compensation::kNone));  // 2 s
+  StepSpec hold;
+  hold.kind = StepKind::kHold;
+  hold.time_s = 0.5;
+  spec.steps.push_back(hold);
+  StepSpec end;
+  end.kind = StepKind::kRepeatEnd;
+  spec.steps.push_back(end);
+  spec.steps.push_back(blocks({{0.0, 0.01, 4.0, 4}, {0.0, 0.02, 2.0, 2}}, 3));  // 3 x 2 s
+  ProcedureRunner runner(spec, kTs, 0);
+  LagPlant plant;
+  const auto log = play(runner, plant, 1000000);
+  ASSERT_TRUE(runner.finished());
+  // The first tick of the first sine's ramp-in: 11 cycles of 0.2 s, the
+  // hold, the second pass (11 cycles and the hold), the block program.
+  double first_run = -1.0;
+  for (const auto& t : log) {
+    if (t.status.phase == ProcedurePhase::kRampIn) {
+      first_run = t.status.time_left_s;
+      break;
+    }
+  }
+  EXPECT_NEAR(first_run, 2.2 + 0.5 + 2.2 + 0.5 + 6.0, 0.01);
+  // Within a test cycle it falls by the period per tick.
+  for (std::size_t i = 1; i < log.size(); ++i) {
+    const auto& a = log[i - 1].status;
+    const auto& b = log[i].status;
+    if (a.phase == ProcedurePhase::kRun && b.phase == ProcedurePhase::kRun && a.step == b.step &&
+        a.total_cycles == b.total_cycles && spec.steps[static_cast<std::size_t>(a.step)].kind != StepKind::kHold) {
+      EXPECT_NEAR(a.time_left_s - b.time_left_s, kTs, 1e-9) << i;
+    }
+  }
+  EXPECT_EQ(runner.status().time_left_s, 0.0);
+}

@@ -221,3 +221,30 @@ TEST(RigLoopSafety, AnInterlockMakesTheValveSafeOnTheTickItTrips) {
   EXPECT_EQ(rig.driver.u, 0.0) << "the valve is at its safe command";
   EXPECT_GE(rig.driver.safe_calls, 1);
 }
+
+// "Stop at the end of the block" asks a test procedure; a run without one
+// refuses it with that reason, even while running, and keeps running.
+TEST(RigLoopSafety, StopAtBlockEndWithoutAProcedureIsRefusedAndChangesNothing) {
+  Rig rig;
+  rig.driver.on_read = [&](int64_t tick) {
+    if (tick == 0) {
+      uint64_t seq = 1;
+      for (K k : {K::kReset, K::kHydraulicsLow, K::kHydraulicsHigh, K::kArm, K::kStart}) rig.send(k, seq++);
+    }
+    if (tick == 200) rig.send(K::kStopAtBlockEnd, 20);
+    if (tick == 400) rig.stop = true;
+  };
+  rig.run(false);
+  const EventRecord* refused = nullptr;
+  for (const auto& e : rig.events.events) {
+    if (e.event.code == EventCode::kCommandRejected) refused = &e;
+  }
+  ASSERT_NE(refused, nullptr);
+  EXPECT_EQ(refused->sequence, 20u);
+  EXPECT_EQ(refused->event.detail, static_cast<uint8_t>(Rejection::kNoProcedure));
+  EXPECT_EQ(refused->state, SafetyState::kRunning);
+  using S = SafetyState;
+  const std::vector<S> expected{S::kOff,     S::kHydraulicsLow, S::kHydraulicsHigh, S::kArmed,
+                                S::kRunning, S::kStopping,      S::kHydraulicsHigh};
+  EXPECT_EQ(rig.events.states(), expected);
+}

@@ -141,3 +141,24 @@ TEST(ProcedureConfig, DriveFileErrorsNameTheStepAndFile) {
     EXPECT_NE(std::string(e.what()).find("missing.csv"), std::string::npos) << e.what();
   }
 }
+
+TEST(ProcedureConfig, CaptureIsReadAndItsErrorsNameTheKey) {
+  const std::string ok =
+      "capture: {channels: [f_t, x_r], histories: none, pre_trigger: 1.5, post_trigger: 2}\n"
+      "steps:\n  - hold: {time: 1}\n";
+  const ProcedureSpec spec = procedure_from_string(ok, "proc.yaml", kContext);
+  EXPECT_TRUE(spec.capture.enabled);
+  EXPECT_EQ(spec.capture.channels, (std::vector<int>{kLayout.input_index("f_t"), kLayout.input_index("x_r")}));
+  EXPECT_FALSE(spec.capture.log_spaced_histories);
+  EXPECT_EQ(spec.capture.pre_trigger_s, 1.5);
+  EXPECT_EQ(spec.capture.post_trigger_s, 2.0);
+  EXPECT_FALSE(procedure_from_string("steps:\n  - hold: {time: 1}\n", "proc.yaml", kContext).capture.enabled);
+  const std::string bad_history = "capture: {histories: every}\nsteps:\n  - hold: {time: 1}\n";
+  EXPECT_NE(error_of(bad_history).find("proc.yaml:1: capture.histories: log_spaced or none, not 'every'"), std::string::npos)
+      << error_of(bad_history);
+  const std::string bad_channel = "capture:\n  channels: [force]\nsteps:\n  - hold: {time: 1}\n";
+  EXPECT_NE(error_of(bad_channel).find("capture.channels: unknown channel 'force'"), std::string::npos)
+      << error_of(bad_channel);
+  const std::string typo = "capture:\n  pre_triger: 1\nsteps:\n  - hold: {time: 1}\n";
+  EXPECT_NE(error_of(typo).find("proc.yaml:2: capture.pre_triger: unknown key"), std::string::npos) << error_of(typo);
+}
