@@ -300,7 +300,7 @@ RunReport run_rig(const RigConfig& config_file, const RunOptions& options, const
                                   : static_cast<std::size_t>(10.0 / config.loop.period_s);
   // Before the publisher: the publisher's last messages at its stop still
   // reach the server's feed.
-  foxglove::StationDescription station = console_station(config, rig.driver->layout(), rig.setpoint_name);
+  foxglove::StationDescription station = console_station(config, rig.driver->layout(), rig.setpoint_name, rig.more_setpoint_names);
   station.commands = operator_run && options.operator_commands == nullptr;  // the run's own receiver takes them
   const auto foxglove_server = make_foxglove_server(config, options, station);
   TelemetryPublisher publisher(meta, url, report.log_path, queue_capacity);
