@@ -199,6 +199,38 @@ TEST_F(TwoPosterIteration, ReachesAPitchCoupledTargetOnBothAxlesWithinSixIterati
   EXPECT_EQ(response.names, (std::vector<std::string>{"t", "a_s1", "a_s1_target", "a_s2", "a_s2_target"}));
 }
 
+TEST_F(TwoPosterIteration, ReachesItFromTheNominalRigsFrfOnARigWornByTheHiddenEffectGenerator) {
+  // The target: the road on the shipped rig with the rear post's seal worn
+  // (a turbulent leak, 300 N of seal friction) by `rigctl make-run`; the FRF:
+  // the shipped rig as new; the drives played with the same effects (--effect).
+  write_road(dir_ + "/road.csv", 1.0);
+  const std::string nominal = write(dir_ + "/nominal.yaml", test::shipped_config("half_car_two_poster.yaml"));
+  const std::string road = write(dir_ + "/road_nominal.yaml", road_config(test::read_file(nominal), "road.csv"));
+  const std::string effects = " --effect cross_port_leakage_2 --effect actuator_seal_friction_2";
+  const auto made = rigctl("make-run --rig two_poster --config " + road + effects + " --tolerance 0 --form 0 --seed 1 --out " +
+                           dir_ + "/road_run.csv");
+  ASSERT_EQ(made.exit_code, 0) << made.output;
+  write_target(dir_ + "/road_run.csv", dir_ + "/target.csv");
+  const auto id = rigctl("identify " + nominal + " --fast --no-realtime --out " + dir_ + "/nominal_frf.json --log " + dir_ +
+                         "/id.lcm --response a_s1 --response a_s2");
+  ASSERT_EQ(id.exit_code, 0) << id.output;
+  const std::string out = dir_ + "/iterate";
+  const auto r = rigctl("iterate " + nominal + " --fast --no-realtime --frf " + dir_ + "/nominal_frf.json --target " + dir_ +
+                        "/target.csv --channel a_s1,a_s2 --out " + out + effects);
+  std::cout << r.output;
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto s = summary_of(out);
+  EXPECT_EQ(s["end"], "tolerance") << s["end_detail"];
+  const auto& its = s["iterations"];
+  ASSERT_LE(its.size(), 6u);
+  for (const std::string ch : {"a_s1", "a_s2"}) {
+    EXPECT_LE(its.back()["rel_rms_percent"][ch].get<double>(), 5.0) << ch;
+    for (std::size_t k = 1; k < its.size(); ++k) {
+      EXPECT_LT(its[k]["rel_rms_percent"][ch].get<double>(), its[k - 1]["rel_rms_percent"][ch].get<double>()) << ch;
+    }
+  }
+}
+
 TEST_F(TwoPosterIteration, ATargetBeyondThePostsIsRefusedNamingTheActuatorAndTheLimit) {
   const std::string frf = identify();
   // The same road 12 times as large: asked of the body, it needs more than the posts can give.
