@@ -49,6 +49,7 @@ std::string station_json(const StationDescription& station) {
               {"senderHint", station.sender_hint},
               {"detectors", detectors},
               {"scope", station.scope_channels},
+              {"demands", station.demands},
               {"states", command_table()}}
       .dump();
 }

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace rigctl::foxglove {
@@ -27,10 +28,13 @@ struct StationDescription {
   std::string sender_hint;                  // a default sender id for the page
   std::vector<StationDetector> detectors;
   std::vector<std::string> scope_channels;  // the sample's fields to plot by default, in order
+  // Each control channel's demand and feedback (x_ref_1 and z_r1, ...), drawn
+  // together in one strip per channel; one pair on a one-channel rig.
+  std::vector<std::pair<std::string, std::string>> demands;
 };
 
 // The JSON text: {"rig", "commands", "senderHint", "detectors": [...],
-// "scope": [...], "states": {STATE: {COMMAND: {"allowed", "to"|"refused"}}}}.
+// "scope": [...], "demands": [[demand, feedback], ...], "states": {STATE: {COMMAND: {"allowed", "to"|"refused"}}}}.
 std::string station_json(const StationDescription& station);
 
 }  // namespace rigctl::foxglove

@@ -281,6 +281,39 @@ std::string schema_of(const rigctl::procedure_t&) {
   return b.build("rigctl.Procedure", "A test procedure's step, counts, compensation and damage (docs/procedures.md)");
 }
 
+// --- channels ---------------------------------------------------------------
+
+// Channel k (2, 3, ...: the first is command_t's and controller_t's) by its
+// demand's run-file name (x_ref_2) and, suffixed with k, its fed-back input,
+// output and saturation.
+std::string channel_suffix(std::size_t i) { return "_" + std::to_string(i + 2); }
+
+std::string json_of(const rigctl::channels_t& c) {
+  Json j{{kTimeColumn, c.t}, {"tick", c.tick}};
+  for (std::size_t i = 0; i < c.setpoint_names.size(); ++i) {
+    const std::string k = channel_suffix(i);
+    j[c.setpoint_names[i]] = i < c.setpoints.size() ? c.setpoints[i] : 0.0;
+    j["measurement" + k] = i < c.measurements.size() ? c.measurements[i] : 0.0;
+    j["output" + k] = i < c.outputs.size() ? c.outputs[i] : 0.0;
+    j["saturated" + k] = i < c.saturated.size() && c.saturated[i] != 0;
+  }
+  return j.dump();
+}
+
+std::string schema_of(const rigctl::channels_t& c) {
+  SchemaBuilder b;
+  b.time();
+  b.integer("tick", "loop tick");
+  for (std::size_t i = 0; i < c.setpoint_names.size(); ++i) {
+    const std::string k = channel_suffix(i);
+    b.number(c.setpoint_names[i], "", "control channel " + k.substr(1) + "'s setpoint, in its feedback input's unit");
+    b.number("measurement" + k, "", "control channel " + k.substr(1) + "'s fed-back input");
+    b.number("output" + k, "", "control channel " + k.substr(1) + "'s output as commanded");
+    b.boolean("saturated" + k, "control channel " + k.substr(1) + "'s output at its limit");
+  }
+  return b.build("rigctl.Channels", "The control channels after the first on one tick (rigs with several actuators)");
+}
+
 template <typename Msg>
 std::optional<TelemetryMessage> decode_as(const uint8_t* data, std::size_t size) {
   Msg m;
@@ -306,6 +339,7 @@ const std::string& TelemetryTopics::channel_of(TelemetryTopic topic) const {
     case TelemetryTopic::kState: return channels_.state;
     case TelemetryTopic::kDriver: return channels_.driver;
     case TelemetryTopic::kProcedure: return channels_.procedure;
+    case TelemetryTopic::kChannels: return channels_.channels;
   }
   return channels_.sample;
 }
@@ -319,6 +353,7 @@ std::string schema_name(TelemetryTopic topic) {
     case TelemetryTopic::kState: return "rigctl.State";
     case TelemetryTopic::kDriver: return "rigctl.DriverStatus";
     case TelemetryTopic::kProcedure: return "rigctl.Procedure";
+    case TelemetryTopic::kChannels: return "rigctl.Channels";
   }
   return "rigctl.Unknown";
 }
@@ -332,6 +367,7 @@ std::optional<TelemetryMessage> decode_telemetry(TelemetryTopic topic, const uin
     case TelemetryTopic::kState: return decode_as<rigctl::state_t>(data, size);
     case TelemetryTopic::kDriver: return decode_as<rigctl::driver_status_t>(data, size);
     case TelemetryTopic::kProcedure: return decode_as<rigctl::procedure_t>(data, size);
+    case TelemetryTopic::kChannels: return decode_as<rigctl::channels_t>(data, size);
   }
   return std::nullopt;
 }

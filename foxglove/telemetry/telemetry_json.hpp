@@ -11,6 +11,7 @@
 #include <string>
 #include <variant>
 
+#include "rigctl/channels_t.hpp"
 #include "rigctl/command_t.hpp"
 #include "rigctl/controller_t.hpp"
 #include "rigctl/driver_status_t.hpp"
@@ -22,14 +23,18 @@
 
 namespace rigctl::foxglove {
 
-enum class TelemetryTopic { kSample, kCommand, kController, kTiming, kState, kDriver, kProcedure };
-inline constexpr TelemetryTopic kTelemetryTopics[] = {TelemetryTopic::kSample,    TelemetryTopic::kCommand,
+// kChannels: the control channels after the first, on rigs with several
+// (<prefix>CHANNELS, lcmtypes/rigctl_channels_t.lcm; a one-channel rig never
+// publishes it, so its clients see what they always saw).
+enum class TelemetryTopic { kSample, kCommand, kController, kTiming, kState, kDriver, kProcedure, kChannels };
+inline constexpr TelemetryTopic kTelemetryTopics[] = {TelemetryTopic::kSample,     TelemetryTopic::kCommand,
                                                       TelemetryTopic::kController, TelemetryTopic::kTiming,
-                                                      TelemetryTopic::kState,     TelemetryTopic::kDriver,
-                                                      TelemetryTopic::kProcedure};
+                                                      TelemetryTopic::kState,      TelemetryTopic::kDriver,
+                                                      TelemetryTopic::kProcedure,  TelemetryTopic::kChannels};
 
 using TelemetryMessage = std::variant<rigctl::sample_t, rigctl::command_t, rigctl::controller_t, rigctl::timing_t,
-                                      rigctl::state_t, rigctl::driver_status_t, rigctl::procedure_t>;
+                                      rigctl::state_t, rigctl::driver_status_t, rigctl::procedure_t,
+                                      rigctl::channels_t>;
 
 // The telemetry channels of one channel prefix (e.g. RIGCTL_SAMPLE).
 class TelemetryTopics {

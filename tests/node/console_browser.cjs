@@ -4,7 +4,7 @@
 // and writes what it saw to --out; screenshots go to --screenshots.
 //
 //   node console_browser.cjs --url http://127.0.0.1:PORT/ --key HEX --wrong-key HEX
-//        --screenshots DIR --out result.json [--scenario commands|trip]
+//        --screenshots DIR --out result.json [--scenario commands|trip|channels]
 //
 // commands: traces update; take control; reset .. start drive the rig to
 //   running; a wrong key, a stale and a replayed hold are refused with their
@@ -16,6 +16,9 @@
 // procedure: a run of a block program (rigctl run --procedure): the procedure
 //   panel counts; hold, resume and "stop at block end" from the page, the
 //   request shown until the block ends and the rig stops there.
+// channels: a rig with several control channels (the two-poster): the scope
+//   lists every channel's demand, feedback and valve, each demand with its
+//   feedback in a strip of its own, and every trace updates.
 "use strict";
 const fs = require("fs");
 const os = require("os");
@@ -256,6 +259,23 @@ async function procedureScenario(browser, args, result, log) {
   result.hydraulicsOff = await answer(a, "hydraulics_off");
 }
 
+async function channelsScenario(browser, args, result, log) {
+  const a = await openConsole(browser, args.url, log);
+  // Every channel's demand has come and updated: x_ref_2 arrives on its own topic (RIGCTL_CHANNELS).
+  await a.waitForFunction(() => {
+    const s = window.rigctlConsole.scope.series;
+    return ["x_ref_1", "z_r1", "x_ref_2", "z_r2", "u_1", "u_2"].every((n) => s.has(n) && s.get(n).received > 200);
+  }, POLL);
+  result.toggles = await a.$$eval("#channels input", (items) => items.map((e) => ({ name: e.dataset.channel, checked: e.checked })));
+  result.series = await a.evaluate(() => [...window.rigctlConsole.scope.series.values()].map((s) => ({
+    name: s.name, group: s.group, unit: s.unit, received: s.received })));
+  result.strips = await a.evaluate(() => window.rigctlConsole.scope.strips().map(([unit, list]) => list.map((s) => s.name)));
+  const drawn = await a.evaluate(() => window.rigctlConsole.scope.drawn);
+  await a.waitForFunction((n) => window.rigctlConsole.scope.drawn > n, POLL, drawn);
+  result.framesDrawn = await a.evaluate(() => window.rigctlConsole.scope.drawn);
+  await a.screenshot({ path: path.join(args.screenshots, "two_poster.png"), fullPage: true });
+}
+
 async function main() {
   const args = parseArgs(process.argv);
   fs.mkdirSync(args.screenshots, { recursive: true });
@@ -265,6 +285,7 @@ async function main() {
   try {
     if (args.scenario === "trip") await tripScenario(browser, args, result, result.log);
     else if (args.scenario === "procedure") await procedureScenario(browser, args, result, result.log);
+    else if (args.scenario === "channels") await channelsScenario(browser, args, result, result.log);
     else await commandsScenario(browser, args, result, result.log);
   } catch (e) {
     result.error = String(e && e.stack || e);

@@ -27,7 +27,7 @@ const RigEffectGenerator& effect_generator(RigKind rig) {
     case RigKind::kQuarterCar: return quarter_car_effect_generator();
     case RigKind::kPneumaticRotary: return pneumatic_rotary_effect_generator();
     case RigKind::kHalfCar: return half_car_effect_generator();
-    case RigKind::kTwoPoster: throw std::invalid_argument("make-run: no hidden effects for the two_poster rig yet");
+    case RigKind::kTwoPoster: return two_poster_effect_generator();
   }
   throw std::logic_error("effect_generator: rig kind out of range");
 }
@@ -69,8 +69,10 @@ void write_truth(const std::string& path, const MakeRunOptions& o, const std::ve
 std::vector<AppliedEffect> make_run(const MakeRunOptions& o, std::ostream& progress) {
   const RigEffectGenerator& gen = effect_generator(o.rig);
   if (o.out_csv.empty()) throw std::invalid_argument("make-run needs an output run file (--out)");
-  const std::string config_path =
-      o.config_path.empty() ? "config/" + std::string(to_string(o.rig)) + ".yaml" : o.config_path;
+  // The shipped config of each rig kind; the two-poster's is named for the car on it.
+  const std::string config_path = !o.config_path.empty()         ? o.config_path
+                                  : o.rig == RigKind::kTwoPoster ? std::string("config/half_car_two_poster.yaml")
+                                                                 : "config/" + std::string(to_string(o.rig)) + ".yaml";
   const std::string case_name = o.case_name.empty() ? gen.excitation_case : o.case_name;
   RigConfig config = load_rig_config(config_path, case_name);
   if (config.rig != o.rig) {

@@ -9,5 +9,6 @@ namespace rigctl {
 const RigEffectGenerator& quarter_car_effect_generator();
 const RigEffectGenerator& pneumatic_rotary_effect_generator();
 const RigEffectGenerator& half_car_effect_generator();
+const RigEffectGenerator& two_poster_effect_generator();
 
 }  // namespace rigctl

@@ -191,7 +191,9 @@ FrfData parse_frf_json(const std::string& text, const std::string& name) {
     throw FrfFileError(name + ": not JSON: " + e.what());
   }
   if (!root.IsMap()) throw FrfFileError(name + ": not an FRF file (a JSON object expected)");
-  if (r.as<std::string>(root, "format", "") != "rigctl-frf") r.fail("format", "not rigctl-frf");
+  const auto format = r.as<std::string>(root, "format", "");
+  if (format == "rigctl-frf-matrix") r.fail("format", "a matrix FRF file (several drives, rigctl-frf-matrix); this reads single-channel files (rigctl-frf)");
+  if (format != "rigctl-frf") r.fail("format", "not rigctl-frf");
   if (r.as<int>(root, "version", "") != kFrfFormatVersion) r.fail("version", "this rigctl reads version " + std::to_string(kFrfFormatVersion));
   FrfData f;
   f.rig = r.as<std::string>(root, "rig", "");

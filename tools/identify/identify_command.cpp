@@ -12,6 +12,7 @@
 #include "tools/identify/excitation_profile.hpp"
 #include "tools/identify/frf_file.hpp"
 #include "tools/identify/identify_analysis.hpp"
+#include "tools/identify/mimo_identify.hpp"
 #include "tools/identify/plant_linearisation.hpp"
 #include "tools/run/rig_assembly.hpp"
 
@@ -87,7 +88,17 @@ std::vector<FrfChannel> frf_channels(const RigConfig& c, const std::vector<std::
 
 IdentifyResult run_identify(const IdentifyOptions& o, const std::atomic<bool>& stop, std::ostream& out) {
   IdentifyResult result;
-  result.plan = plan_identification(load_rig_config(o.config_path, o.case_name), o.settings);
+  RigConfig config = load_rig_config(o.config_path, o.case_name);
+  if (!config.more_channels.empty()) {
+    MimoIdentifyResult m = run_mimo_identify(o, stop, out);
+    result.aborted = m.aborted;
+    result.abort_reason = m.abort_reason;
+    result.matrix = std::move(m.matrix);
+    result.run = std::move(m.run);
+    if (!o.plot_path.empty()) out << "  --plot: not drawn for a matrix FRF (no plot of one yet)\n";
+    return result;
+  }
+  result.plan = plan_identification(std::move(config), o.settings);
   const IdentifyPlan& plan = result.plan;
   const Excitation excitation = make_excitation(plan.excitation);
   describe_plan(plan, out);

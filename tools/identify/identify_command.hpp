@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "tools/identify/frf_data.hpp"
+#include "tools/identify/frf_matrix_file.hpp"
 #include "tools/identify/identify_plan.hpp"
 #include "tools/run/run_command.hpp"
 
@@ -32,6 +33,7 @@ struct IdentifyResult {
   std::string abort_reason;  // the trip, e.g. "limit_tripped: x_r_rate"
   IdentifyPlan plan;
   FrfData frf;
+  FrfMatrixData matrix;  // a rig with several control channels: the matrix instead of `frf` (mimo_identify.hpp)
   RunReport run;
 };
 
@@ -40,7 +42,8 @@ struct IdentifyResult {
 std::vector<FrfChannel> frf_channels(const RigConfig& config, const std::vector<std::string>& names);
 
 // Throws ConfigError for a bad config or settings, std::runtime_error for a
-// run or record that cannot be analysed.
+// run or record that cannot be analysed. A config with `channels:` is
+// identified as a matrix (tools/identify/mimo_identify.hpp).
 IdentifyResult run_identify(const IdentifyOptions& options, const std::atomic<bool>& stop, std::ostream& out);
 
 // Runs tools/plots/plot_frf.py on an FRF (and optionally a tuning) file;

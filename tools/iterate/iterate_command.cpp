@@ -14,6 +14,7 @@
 #include "tools/identify/plant_linearisation.hpp"
 #include "tools/iterate/diagnosis_model.hpp"
 #include "tools/iterate/iteration_files.hpp"
+#include "tools/iterate/mimo_iterate_command.hpp"
 #include "tools/iterate/target_file.hpp"
 #include "tools/iterate/test_window.hpp"
 #include "tools/run/rig_assembly.hpp"
@@ -126,6 +127,18 @@ IterationSummary summary_of(const IterateOptions& o, const RigConfig& rig, const
 IterateResult run_iterate(const IterateOptions& o, const std::atomic<bool>& stop, std::ostream& out) {
   if (o.channel.empty()) throw std::invalid_argument("--channel: the target channel is required");
   const RigConfig nominal = load_rig_config(o.config_path, o.case_name);
+  if (!nominal.more_channels.empty()) {
+    // Several drives: the MIMO iteration (mimo_iterate_command.hpp).
+    const MimoIterateResult m = run_mimo_iterate(o, stop, out);
+    IterateResult r;
+    r.summary_path = m.summary_path;
+    r.outcome.end = m.iteration.converged ? IterationEnd::kTolerance
+                    : m.iteration.stopped.find("not played") != std::string::npos ? IterationEnd::kDriveLimit
+                    : !m.iteration.stopped.empty()                              ? IterationEnd::kRunEnded
+                                                                                : IterationEnd::kMaxIterations;
+    r.outcome.end_detail = m.iteration.stopped;
+    return r;
+  }
   const RigConfig rig = rig_config(o, nominal);
   const double dt = rig.loop.period_s;
   IterationSettings s = o.settings;

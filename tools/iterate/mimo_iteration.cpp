@@ -56,7 +56,7 @@ double band_relative_rms(const std::vector<double>& target, const std::vector<do
 }
 
 MimoIterationResult iterate_mimo(const MimoDriveInverse& inverse, const Records& targets, const PlayDrives& play,
-                                 const MimoIterationSettings& s) {
+                                 const MimoIterationSettings& s, const MimoIterationHooks& hooks) {
   check_shapes(inverse, targets);
   const auto& bands = inverse.bands();
   const double low = bands.edges_hz[1], high = bands.edges_hz.back();
@@ -67,13 +67,26 @@ MimoIterationResult iterate_mimo(const MimoDriveInverse& inverse, const Records&
   gain.setOnes();
   Eigen::MatrixXd previous_energy;
   for (int it = 0; it < s.max_iterations; ++it) {
-    result.responses = play(result.drives);
+    if (hooks.admit) {
+      const std::string why = hooks.admit(result.drives, it + 1);
+      if (!why.empty()) {
+        result.stopped = "drive " + std::to_string(it + 1) + " not played: " + why;
+        break;
+      }
+    }
+    Records played = play(result.drives);
+    if (played.empty()) {
+      result.stopped = "drive " + std::to_string(it + 1) + "'s run did not complete";
+      break;
+    }
+    result.responses = std::move(played);
     const Records error = minus(targets, result.responses);
     std::vector<double> rms;
     for (std::size_t j = 0; j < targets.size(); ++j) {
       rms.push_back(band_relative_rms(targets[j], result.responses[j], s.period_s, low, high));
     }
     result.error.push_back(rms);
+    if (hooks.on_iteration) hooks.on_iteration(it + 1, result.drives, result.responses, rms);
     bool within = true;
     for (double r : rms) within = within && r <= s.tolerance;
     if (within) {

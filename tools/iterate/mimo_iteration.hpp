@@ -11,6 +11,7 @@
 #pragma once
 
 #include <functional>
+#include <string>
 #include <vector>
 
 #include "tools/iterate/mimo_inverse.hpp"
@@ -33,10 +34,21 @@ struct MimoIterationResult {
   Records drives;                          // the last played drives
   Records responses;                       // and what they gave
   bool converged = false;
+  std::string stopped;                     // not empty: a drive was refused or its run did not complete, and why
 };
 
+// What a command adds around the loop (all optional): a safety check of
+// each drive before it is played (returns "" to play it, else the refusal),
+// and each played iteration's records (1-based index) as they come.
+struct MimoIterationHooks {
+  std::function<std::string(const Records& drives, int iteration)> admit;
+  std::function<void(int iteration, const Records& drives, const Records& responses, const std::vector<double>& error)> on_iteration;
+};
+
+// `play` returns no records when the run did not complete (its own report
+// says why); the iteration then stops with `stopped` set, as at a refusal.
 MimoIterationResult iterate_mimo(const MimoDriveInverse& inverse, const Records& targets, const PlayDrives& play,
-                                 const MimoIterationSettings& settings);
+                                 const MimoIterationSettings& settings, const MimoIterationHooks& hooks = {});
 
 // Relative RMS of target - response in [low_hz, high_hz].
 double band_relative_rms(const std::vector<double>& target, const std::vector<double>& response, double period_s,

@@ -37,7 +37,8 @@ std::string threshold(const DetectorConfig& d) {
 }  // namespace
 
 foxglove::StationDescription console_station(const RigConfig& config, const ChannelLayout& layout,
-                                             const std::string& setpoint_name) {
+                                             const std::string& setpoint_name,
+                                             const std::vector<std::string>& more_setpoint_names) {
   foxglove::StationDescription s;
   s.rig = std::string(to_string(config.rig));
   for (const auto& l : config.limits) {
@@ -50,11 +51,21 @@ foxglove::StationDescription console_station(const RigConfig& config, const Chan
   }
   // Demand and feedback, what drives the valve, then the pressures: the
   // channels an operator watches on every rig kind; the page offers the rest.
-  if (!setpoint_name.empty()) s.scope_channels.push_back(setpoint_name);
-  s.scope_channels.push_back(config.controller.feedback);
+  // Every control channel's demand and feedback on a rig with several.
+  if (!setpoint_name.empty()) s.demands.emplace_back(setpoint_name, config.controller.feedback);
+  for (std::size_t i = 0; i < more_setpoint_names.size() && i < config.more_channels.size(); ++i) {
+    s.demands.emplace_back(more_setpoint_names[i], config.more_channels[i].controller.feedback);
+  }
+  if (setpoint_name.empty()) s.scope_channels.push_back(config.controller.feedback);
+  for (const auto& [demand, feedback] : s.demands) {
+    s.scope_channels.push_back(demand);
+    s.scope_channels.push_back(feedback);
+  }
   for (const auto& o : layout.outputs) s.scope_channels.push_back(o.name);
   for (const auto& i : layout.inputs) {
-    if (i.unit == "Pa" && i.name != config.controller.feedback) s.scope_channels.push_back(i.name);
+    bool fed_back = i.name == config.controller.feedback;
+    for (const auto& ch : config.more_channels) fed_back = fed_back || i.name == ch.controller.feedback;
+    if (i.unit == "Pa" && !fed_back) s.scope_channels.push_back(i.name);
   }
   return s;
 }

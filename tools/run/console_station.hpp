@@ -5,6 +5,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "config/rig_config.hpp"
 #include "foxglove/console/station.hpp"
@@ -12,7 +13,10 @@
 
 namespace rigctl {
 
+// more_setpoint_names: the demands of the control channels after the first
+// (x_ref_2, ...), empty on a one-channel rig.
 foxglove::StationDescription console_station(const RigConfig& config, const ChannelLayout& layout,
-                                             const std::string& setpoint_name);
+                                             const std::string& setpoint_name,
+                                             const std::vector<std::string>& more_setpoint_names = {});
 
 }  // namespace rigctl

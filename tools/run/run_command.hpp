@@ -59,6 +59,10 @@ struct RunOptions {
   // assembled rig's channels. Everything else, the safety machinery above
   // all, is the config's.
   std::function<std::unique_ptr<SetpointProfile>()> profile_override;
+  // The same for the control channels after the first (`channels:`), by
+  // their 0-based index (1: the second channel): a multi-channel
+  // identification or drive excites every channel.
+  std::function<std::unique_ptr<SetpointProfile>(std::size_t channel)> more_profile_override;
   std::function<std::unique_ptr<Controller>(const ChannelLayout&)> controller_override;
   // --procedure PROC.yaml: a test procedure gives the demand and ends the run
   // (docs/procedures.md); --resume RECOVERY continues one; the recovery is

@@ -46,6 +46,14 @@ SimDriver* apply_run_options(AssembledRig& rig, const RigConfig& config, const R
     rig.profile_duration_s = raw->duration();
     rig.profile = std::make_unique<FilteredProfile>(std::move(raw), 0.0, config.loop.period_s);
   }
+  if (options.more_profile_override) {
+    for (std::size_t i = 0; i < rig.more_profiles.size(); ++i) {
+      auto raw = options.more_profile_override(i + 1);
+      rig.profile_duration_s = std::max(rig.profile_duration_s, raw->duration());
+      rig.more_profiles[i] = std::make_unique<FilteredProfile>(std::move(raw), 0.0, config.loop.period_s);
+      rig.more_channels[i].profile = rig.more_profiles[i].get();
+    }
+  }
   if (options.controller_override) rig.controller = options.controller_override(rig.driver->layout());
   if (options.fast && !rig.driver->simulated()) {
     throw std::runtime_error("--fast needs a simulated driver: '" + std::string(to_string(config.driver)) + "' runs real hardware in real time");

@@ -61,7 +61,8 @@ std::unique_ptr<foxglove::TelemetryServer> make_foxglove_server(const RunOptions
   const RigConfig& config = plan.config;
   const auto ws = websocket_settings(config.telemetry.websocket, options.websocket);
   if (!ws) return nullptr;
-  foxglove::StationDescription station = console_station(config, plan.rig.driver->layout(), plan.rig.setpoint_name);
+  foxglove::StationDescription station = console_station(config, plan.rig.driver->layout(), plan.rig.setpoint_name,
+                                                           plan.rig.more_setpoint_names);
   station.commands = plan.operator_run && options.operator_commands == nullptr;
   foxglove::ServerOptions so = server_options(*ws);
   so.name = "rigctl " + std::string(to_string(config.rig));

@@ -33,9 +33,14 @@
   // The strip a channel goes in: the setpoint and its feedback share one
   // (the command message does not carry the setpoint's unit), the others
   // one per unit.
+  // On a rig with several control channels each channel's demand and
+  // feedback share a strip of their own (the station's demand pairs).
   function groupFor(name, units) {
+    const demands = (page.station && page.station.demands) || [];
+    const k = demands.findIndex((pair) => pair.includes(name));
+    if (k >= 0) return k === 0 ? "demand" : "demand " + (k + 1);
     const scopeList = ((page.station && page.station.scope) || []).filter((n) => n);
-    if (scopeList.length > 1 && (name === scopeList[0] || name === scopeList[1])) return "demand";
+    if (!demands.length && scopeList.length > 1 && (name === scopeList[0] || name === scopeList[1])) return "demand";
     return units[name] || "";
   }
 
@@ -53,10 +58,11 @@
     $("channels").append(label);
   }
 
-  function plot(channel, m) {
+  // keep(name): the fields of the message to plot (default all numbers).
+  function plot(channel, m, keep = () => true) {
     const units = unitsOf(channel);
     for (const [name, v] of Object.entries(m)) {
-      if (name === "t" || name === "tick" || typeof v !== "number") continue;
+      if (name === "t" || name === "tick" || typeof v !== "number" || !keep(name)) continue;
       if (!scope.series.has(name)) {
         scope.add(name, groupFor(name, units), units[name] || "");
         addChannelToggle(name);
@@ -83,6 +89,9 @@
   function onMessage(channel, m) {
     switch (channel.schemaName) {
       case "rigctl.Sample": case "rigctl.Command": plot(channel, m); break;
+      // The further channels' demands (x_ref_2, ...); their feedbacks and
+      // outputs come by their own names in Sample and Command.
+      case "rigctl.Channels": plot(channel, m, (name) => !/^(measurement|output)_\d+$/.test(name)); break;
       case "rigctl.State": onState(m); break;
       case "rigctl.Timing": page.timing = m; rigctl.station.renderTiming(page.timing, page.driver); break;
       case "rigctl.DriverStatus": page.driver = m; rigctl.station.renderTiming(page.timing, page.driver); break;

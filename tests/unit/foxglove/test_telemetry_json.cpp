@@ -57,6 +57,37 @@ TEST(TelemetryJson, CommandNamesTheSetpointColumnAndTheOutputs) {
   EXPECT_EQ(json::parse(json_schema(c))["required"], json::array({"t", "tick", "x_ref", "u"}));
 }
 
+TEST(TelemetryJson, ChannelsNameEachFurtherChannelsDemandByItsColumnAndDecodeFromTheirTopic) {
+  rigctl::channels_t c{};
+  c.utime = 1'700'000'000'000'000;
+  c.tick = 40;
+  c.t = 0.1;
+  c.num_channels = 2;
+  c.setpoint_names = {"x_ref_2", "x_ref_3"};
+  c.setpoints = {0.081, 0.079};
+  c.measurements = {0.0805, 0.0792};
+  c.outputs = {0.12, -1.0};
+  c.saturated = {0, 1};
+  std::vector<uint8_t> bytes(static_cast<std::size_t>(c.getEncodedSize()));
+  ASSERT_GT(c.encode(bytes.data(), 0, static_cast<int>(bytes.size())), 0);
+  const TelemetryTopics topics("RIG2_");
+  ASSERT_EQ(topics.topic_of("RIG2_CHANNELS"), TelemetryTopic::kChannels);
+  EXPECT_EQ(schema_name(TelemetryTopic::kChannels), "rigctl.Channels");
+  const auto decoded = decode_telemetry(TelemetryTopic::kChannels, bytes.data(), bytes.size());
+  ASSERT_TRUE(decoded.has_value());
+  const json j = json::parse(to_json(*decoded));
+  EXPECT_EQ(j["x_ref_2"], 0.081);
+  EXPECT_EQ(j["measurement_2"], 0.0805);
+  EXPECT_EQ(j["output_3"], -1.0);
+  EXPECT_EQ(j["saturated_2"], false);
+  EXPECT_EQ(j["saturated_3"], true);
+  EXPECT_EQ(log_time_ns(*decoded), 1'700'000'000'000'000'000ull);
+  const json schema = json::parse(json_schema(*decoded));
+  EXPECT_EQ(schema["title"], "rigctl.Channels");
+  EXPECT_EQ(schema["required"], json::array({"t", "tick", "x_ref_2", "measurement_2", "output_2", "saturated_2", "x_ref_3",
+                                             "measurement_3", "output_3", "saturated_3"}));
+}
+
 TEST(TelemetryJson, ControllerFlagsAreBooleansAndTermsNamed) {
   rigctl::controller_t k{};
   k.controller = "pi";
