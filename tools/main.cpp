@@ -173,6 +173,7 @@ int main(int argc, char** argv) {
   diag_cmd->add_flag("--quiet", diag.quiet, "No progress on stderr");
   diag_cmd->add_option("--catalog", diag.catalog_path, "Also write the diagnosis into this run catalog, linked to the run (docs/rig-health.md)");
   diag_cmd->add_option("--rig-name", diag.rig_name, "With --catalog: the rig's name for a run not yet entered (default: the rig kind)");
+  diag_cmd->add_option("--threads", diag.threads, "Threads of the whole diagnosis (default 2)")->check(CLI::Range(1, 64));
 
   rigctl::MakeRunOptions make;
   std::string make_rig;

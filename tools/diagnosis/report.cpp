@@ -107,7 +107,11 @@ void write_json(const Diagnosis& d, std::ostream& out) {
         << ", \"extended_fit_percent\": " << json_number(c.extended_fit_percent)
         << ", \"gain_percent_points\": " << json_number(c.gain_percent_points) << ", \"signal\": " << json_string(c.signal)
         << ",\n     \"ambiguous_with\": " << json_list(c.ambiguous_with) << ", \"signature\": " << json_string(c.signature)
-        << ", \"where_agrees\": " << (c.where_agrees ? "true" : "false") << "}";
+        << ", \"where_agrees\": " << (c.where_agrees ? "true" : "false");
+    if (!c.channels.empty()) out << ",\n     \"channels\": " << json_list(c.channels);
+    if (!c.form.empty())
+      out << ",\n     \"form\": " << json_string(c.form) << ", \"form_estimation_cost\": " << json_number_map(c.form_costs);
+    out << "}";
   }
   out << (d.causes.empty() ? "],\n" : "\n  ],\n");
   out << "  \"baseline_fit_percent\": " << json_number_map(d.baseline_fit_percent) << ",\n";
@@ -138,6 +142,17 @@ void write_json(const Diagnosis& d, std::ostream& out) {
     out << "}";
   }
   out << (d.calibration.empty() ? "],\n" : "\n  ],\n");
+  out << "  \"loop_timing\": [";
+  bool first_timing = true;
+  for (const auto& c : d.calibration) {
+    if (!c.timing) continue;
+    out << (first_timing ? "\n" : ",\n") << "    {\"name\": " << json_string(c.name) << ", \"unit\": " << json_string(c.unit)
+        << ", \"value\": " << (c.determined ? json_number(c.value) : std::string("null"))
+        << ", \"sigma\": " << (c.determined ? json_number(c.sigma) : std::string("null")) << ", \"bounds\": ["
+        << json_number(c.lo) << ", " << json_number(c.hi) << "]}";
+    first_timing = false;
+  }
+  out << (first_timing ? "],\n" : "\n  ],\n");
   out << "  \"baseline_parameters\": " << json_values(d.baseline_parameters);
   out << ",\n  \"final_parameters\": " << json_values(d.final_parameters);
   out << ",\n  \"undetermined_parameters\": " << json_names_where(d.final_parameters, false);
