@@ -257,5 +257,20 @@ TEST_F(TwoPosterIteration, ATargetBeyondThePostsIsRefusedNamingTheActuatorAndThe
       << why;
 }
 
+TEST_F(TwoPosterIteration, OptionsTheMimoIterationCannotHonourAreRefusedNotIgnored) {
+  write(dir_ + "/target.csv", "t,a_s1,a_s2\n0,0,0\n0.0025,0,0\n");
+  for (const auto& [option, says] : std::vector<std::pair<std::string, std::string>>{
+           {"--scale", "--scale: a rig with several drives"}, {"--window 1:2", "--window: a rig with several drives"},
+           {"--plot", "--plot: no plot of a multi-channel iteration"}}) {
+    const auto r = rigctl("iterate " + rig_ + " --fast --frf " + rig_ + " --target " + dir_ + "/target.csv --channel a_s1,a_s2 --out " +
+                          dir_ + "/it " + option);
+    EXPECT_EQ(r.exit_code, 1) << r.output;
+    EXPECT_NE(r.output.find(says), std::string::npos) << r.output;
+  }
+  const auto id = rigctl("identify " + rig_ + " --fast --excitation chirp --out " + dir_ + "/frf.json");
+  EXPECT_NE(id.exit_code, 0);
+  EXPECT_NE(id.output.find("--excitation: a rig with several drives is excited by orthogonal multisines"), std::string::npos) << id.output;
+}
+
 }  // namespace
 }  // namespace rigctl

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <iomanip>
 #include <span>
+#include <stdexcept>
 
 #include "config/config_reader.hpp"
 #include "tools/identify/channel_view.hpp"
@@ -70,6 +71,10 @@ void describe_matrix(const FrfMatrixData& m, std::ostream& out) {
 }  // namespace
 
 MimoIdentifyPlan plan_mimo_identification(const RigConfig& config, const IdentifySettings& s) {
+  if (s.excitation && *s.excitation != ExcitationKind::kMultisine) {
+    throw std::invalid_argument("--excitation: a rig with several drives is excited by orthogonal multisines (multisine) only, not " +
+                                std::string(to_string(*s.excitation)));
+  }
   MimoIdentifyPlan p;
   p.config = config;
   const std::size_t n = channel_count(config);

@@ -4,7 +4,8 @@
 // (docs/drive-iteration.md). The rig's FRF from the drive to the target
 // channel (measured, or the nominal or a diagnosis's model), its regularised
 // inverse, and drives played through the loop until the response matches
-// the target.
+// the target. A rig with several control channels is iterated as a
+// vector of drives (tools/iterate/mimo_iterate_command.hpp).
 #pragma once
 
 #include <atomic>
@@ -21,8 +22,8 @@ struct IterateOptions {
   std::string config_path;
   std::string case_name;
   std::string target_path;  // run file (t, channel) or RPC III (.rsp, .tim)
-  std::string channel;      // the rig's channel the target is for, e.g. x_w
-  std::string target_channel;  // the file's channel: a name or a 1-based number (default: `channel`)
+  std::string channel;      // the rig's channel the target is for, e.g. x_w; several drives: "a_s1,a_s2" (mimo_iterate_command.hpp)
+  std::string target_channel;  // the file's channel: a name or a 1-based number (default: `channel`); several: a list as `channel`
   // Longest target played [s]: a drive is one run; ten minutes is well
   // beyond a road simulator's usual block (20-120 s) and keeps the record's
   // FFTs and files small. A longer target is refused, not truncated.

@@ -122,6 +122,10 @@ MimoIterateResult run_mimo_iterate(const IterateOptions& o, const std::atomic<bo
     throw std::invalid_argument("--target-channel: " + std::to_string(file_channels.size()) + " channels for --channel's " +
                                 std::to_string(channels.size()));
   }
+  // What the one-channel iteration has and this one has not yet: refused, not ignored.
+  if (o.settings.window_s) throw std::invalid_argument("--window: a rig with several drives iterates the whole target (cut it to the part to reproduce)");
+  if (o.settings.scale_to_fit) throw std::invalid_argument("--scale: a rig with several drives refuses a drive beyond an actuator's limits; it does not scale it yet");
+  if (o.plot) throw std::invalid_argument("--plot: no plot of a multi-channel iteration yet (DIR/iter_NN_response.csv holds each channel and its target)");
   if (!o.model_path.empty()) throw std::invalid_argument("--model: a rig with several channels iterates from a measured FRF matrix (--frf); no model inverse yet");
   if (o.frf_path.empty()) throw std::invalid_argument("--frf: a rig with several channels needs the FRF matrix from `rigctl identify CONFIG --response CHANNEL ...`");
   const RigConfig rig = rig_config(o, load_rig_config(o.config_path, o.case_name));
