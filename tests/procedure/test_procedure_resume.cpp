@@ -131,8 +131,13 @@ TEST(ProcedureResume, KilledAtRandomMomentsAndResumedCountsEveryCycleOnce) {
     if (segment > 0) {
       // This segment continued at the interrupted cycle: its first counted
       // cycle is the one the recovery said (the one being run at the kill).
+      // A killed segment's log lags its loop (the publisher's queue): killed
+      // soon after its ramp-in, it may hold no counted cycle yet, and then
+      // there is nothing to compare (the final count checks the resume).
+      // The last segment ran to its end: its log has them all.
       const LogFacts f = read_log(log);
-      EXPECT_EQ(f.first_counted, killed_at[static_cast<std::size_t>(segment - 1)]) << "segment " << segment;
+      if (last || f.first_counted >= 0)
+        EXPECT_EQ(f.first_counted, killed_at[static_cast<std::size_t>(segment - 1)]) << "segment " << segment;
     }
     if (last) break;
   }
