@@ -34,6 +34,7 @@
 
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <iterator>
 #include <map>
@@ -122,7 +123,7 @@ Sizes sizes(const diag::CauseResult& c, const test::HiddenRun& run) {
   if (c.cause == "polytropic_exponent") return {1.4 - param(c, "n"), 1.4 - tr("n")};
   if (c.cause == "valve_null_offset") return {param(c, "u0"), tr("u0")};
   if (c.cause == "valve_deadband") return {param(c, "delta"), tr("delta")};
-  if (c.cause == "sensor_delay") return {param(c, "tau"), tr("tau")};
+  if (c.cause == "sensor_delay") return {param(c, "tau_theta"), tr("tau")};  // the generator delays theta and dp alike
   ADD_FAILURE() << "no size comparison for " << c.cause;
   return {NAN, NAN};
 }
@@ -160,6 +161,24 @@ std::string summary(const diag::Diagnosis& d) {
   return s;
 }
 
+// A delay on every sensor is, to the loop, the same as the loop's own I/O
+// timing, which the baseline calibrates (t_sample: the sensors sampled
+// before the tick, in the loop and in the record; t_command: the command
+// later, in the loop only). The fitted sensor delay and the timing share the
+// generator's delay: the record's delay is tau + t_sample, the loop's tau +
+// t_sample + t_command, and the truth lies between them (within the
+// tolerance).
+void expect_delay_shared_with_the_loop_timing(const diag::Diagnosis& d, const Sizes& s, double tolerance) {
+  double t_sample = 0.0, t_command = 0.0;
+  for (const auto& c : d.calibration) {
+    if (c.name == "t_sample") t_sample = c.value;
+    if (c.name == "t_command") t_command = c.value;
+  }
+  const double in_record = s.fitted + t_sample, in_loop = in_record + t_command;
+  EXPECT_GE(s.truth, (1.0 - tolerance) * in_record) << "t_sample " << t_sample << ", " << summary(d);
+  EXPECT_LE(s.truth, (1.0 + tolerance) * in_loop) << "t_command " << t_command << ", " << summary(d);
+}
+
 // Each cause alone at `level` in `form`; sized (form 0) or only named (form 1).
 void expect_single_cause_found(const std::vector<std::string>& causes, double level, int form, double tolerance) {
   std::vector<Case> cases;
@@ -180,6 +199,10 @@ void expect_single_cause_found(const std::vector<std::string>& causes, double le
     EXPECT_GT(top.extended_fit_percent, top.baseline_fit_percent);
     if (form != 0) continue;
     const Sizes s = cause == "polytropic_exponent" ? polytropic_sizes(d, top, out[i].run) : sizes(top, out[i].run);
+    if (cause == "sensor_delay") {
+      expect_delay_shared_with_the_loop_timing(d, s, tolerance);
+      continue;
+    }
     EXPECT_NEAR(s.fitted, s.truth, tolerance * std::abs(s.truth)) << summary(d);
     if (cause == "bladder_hysteresis") {
       // Not just a Coulomb step: the fitted element keeps a travel-dependent
@@ -222,6 +245,48 @@ TEST(DiagnosePneumatic, CleanRunIsNone) {
   // to within the sensors' noise and quantisation.
   EXPECT_GT(out[0].d.baseline_fit_percent.at("theta"), 98.0);
   EXPECT_GT(out[0].d.baseline_fit_percent.at("dp"), 97.0);
+}
+
+// The same clean rig recorded on another time base: every time stamp 5 ms
+// later, a quarter of the 50 Hz dither's period, so the dither's ripple sits
+// 90 degrees from where phase 0 would put it (a rig whose dither does not
+// start with the record). That is the rig's timing, not a cause: the phase
+// is read off the record's ripple (-pi/2), the fit is the clean run's, and
+// nothing is named. The loop's I/O timing is reported within its bounds.
+TEST(DiagnosePneumatic, ACleanRunOnAnotherTimeBaseIsCalibratedNotAccused) {
+  const test::HiddenRun run = make_run_file({"clean_shifted", {}, 0});
+  std::ifstream in(run.csv);
+  const std::string shifted = ::testing::TempDir() + "/pneu_clean_shifted_t.csv";
+  std::ofstream out(shifted);
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#' || line[0] == 't') {
+      out << line << "\n";
+      continue;
+    }
+    const auto comma = line.find(',');
+    char t[32];
+    std::snprintf(t, sizeof t, "%.6f", std::stod(line.substr(0, comma)) + 0.005);
+    out << t << line.substr(comma) << "\n";
+  }
+  out.close();
+  const auto rf = read_run_file(shifted, run_file_columns(RunFileRig::kPneumaticRotary));
+  diag::RigModelOptions mo;
+  mo.config_path = kConfig;
+  const auto model = diag::make_rig_model(RunFileRig::kPneumaticRotary, rf, mo);
+  const double phase = model->constants().at("dither_phase_rad");
+  EXPECT_NEAR(std::remainder(phase + M_PI / 2.0, 2.0 * M_PI), 0.0, 0.15) << phase;
+  const auto d = diag::diagnose(*model, {});
+  EXPECT_EQ(d.cause, "none") << summary(d);
+  EXPECT_GT(d.baseline_fit_percent.at("dp"), 97.0);
+  int timing = 0;
+  for (const auto& c : d.calibration)
+    if (c.timing) {
+      ++timing;
+      EXPECT_GE(c.value, c.lo) << c.name;
+      EXPECT_LE(c.value, c.hi) << c.name;
+      EXPECT_LE(c.hi, 2.0 * 0.0025 + 1e-12) << c.name;  // at most two periods
+    }
+  EXPECT_EQ(timing, 2);  // t_command and t_sample
 }
 
 // Through the program, as a user runs it: JSON and the HTML report.

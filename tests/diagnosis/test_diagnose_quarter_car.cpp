@@ -24,9 +24,9 @@
 // within its band, docs/diagnosis.md 4.)
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <algorithm>
 #include <map>
 #include <mutex>
 #include <sstream>
@@ -174,7 +174,10 @@ TEST(HiddenEffectsQuarterCar, StrongSensorDelayIsNamedAndSized) {
   const auto* c = expect_named("sensor_delay_strong", "sensor_delay");
   if (!c) return;
   const double want = truth(outcome("sensor_delay_strong"), "sensor_delay.tau");
-  EXPECT_NEAR(fitted(*c, "tau"), want, 0.2 * want);
+  // The generator's filter is on x_b and x_w, not on the feedback x_r.
+  EXPECT_NEAR(fitted(*c, "tau_x_b"), want, 0.2 * want);
+  EXPECT_NEAR(fitted(*c, "tau_x_w"), want, 0.2 * want);
+  EXPECT_EQ(std::count(c->channels.begin(), c->channels.end(), "x_r"), 0) << c->evidence;
 }
 
 // The actuator's replay drives the tyre with the measured x_w, so a 2 mm
@@ -245,7 +248,7 @@ TEST(HiddenEffectsQuarterCar, WeakSensorDelayIsNamedAsTheWholeMisfit) {
   const auto* c = expect_named("sensor_delay_weak", "sensor_delay");
   if (!c) return;
   const double want = truth(outcome("sensor_delay_weak"), "sensor_delay.tau");
-  EXPECT_NEAR(fitted(*c, "tau"), want, 0.25 * want) << c->evidence;
+  EXPECT_NEAR(fitted(*c, "tau_x_b"), want, 0.25 * want) << c->evidence;
 }
 
 // The seal's Coulomb step is sharp: the candidate's friction is applied

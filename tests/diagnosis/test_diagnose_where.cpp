@@ -13,6 +13,7 @@
 //    command, as a constant;
 //  * the real records of tests/data (EMPS, the MR damper) and a devset run:
 //    the HTML report shows where their baseline's misfit is.
+#include <algorithm>
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -99,8 +100,17 @@ TEST(DiagnoseWhere, HiddenValveNullOffsetIsAnOffsetOfTheCommand) {
   const auto d = where_only(RunFileRig::kPneumaticRotary, run.csv, config);
   ASSERT_TRUE(d.where.computed);
   EXPECT_TRUE(d.where.significant) << listing(d.where);
-  EXPECT_EQ(d.where.places.front().name, "an offset of the valve command") << listing(d.where);
-  EXPECT_TRUE(has_regressor(d.where.places.front(), "constant", 1)) << listing(d.where);
+  // Near the operating point a constant offset of the command is a constant
+  // flow into the chambers (the valve's gain times it): the two places
+  // explain the residual alike (to 6 digits since the valve's command is
+  // replayed through the loop's timing), and either may come first. The
+  // command's offset must be among the best, as a constant.
+  const auto command = std::find_if(d.where.places.begin(), d.where.places.end(),
+                                    [](const diag::WherePlace& p) { return p.name == "an offset of the valve command"; });
+  ASSERT_NE(command, d.where.places.end()) << listing(d.where);
+  EXPECT_GE(command->explained_share, 0.99 * d.where.places.front().explained_share) << listing(d.where);
+  EXPECT_TRUE(has_regressor(*command, "constant", 1)) << listing(d.where);
+  EXPECT_TRUE(diag::where_agrees(d.where, "valve_null_offset")) << listing(d.where);
 }
 
 // The HTML report of each shows where the misfit is: the section, the best

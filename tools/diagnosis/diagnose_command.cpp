@@ -40,6 +40,7 @@ int run_diagnose(const DiagnoseCommandOptions& o, std::ostream& out, std::ostrea
     const auto model = diag::make_rig_model(rig, run, mo);
     diag::DiagnoseOptions dopt;
     dopt.progress = o.quiet ? nullptr : &err;
+    dopt.threads = o.threads;
     d = diag::diagnose(*model, dopt);
   } catch (const RunFileError& e) {
     err << "rigctl diagnose: " << one_line(e.what()) << "\n";

@@ -21,6 +21,7 @@ struct DiagnoseCommandOptions {
   // --data (entered first when it is not there yet; docs/rig-health.md 2).
   std::string catalog_path;
   std::string rig_name;  // --rig-name: the rig's name there (default: the rig kind)
+  int threads = 2;  // --threads: of the whole diagnosis (docs/diagnosis.md 4)
 };
 
 // Returns the exit code: 0 with a diagnosis (including `none`), 2 for bad

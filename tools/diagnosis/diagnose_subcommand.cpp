@@ -24,6 +24,7 @@ class DiagnoseSubcommand final : public Subcommand {
     c->add_flag("--quiet", options_.quiet, "No progress on stderr");
     c->add_option("--catalog", options_.catalog_path, "Also write the diagnosis into this run catalog, linked to the run (docs/rig-health.md)");
     c->add_option("--rig-name", options_.rig_name, "With --catalog: the rig's name for a run not yet entered (default: the rig kind)");
+    c->add_option("--threads", options_.threads, "Threads of the whole diagnosis (default 2)")->check(CLI::Range(1, 64));
     return *c;
   }
 

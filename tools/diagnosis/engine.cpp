@@ -36,7 +36,39 @@ struct Candidate {
   double excess_before = 0.0, excess_after = 0.0;  // its signal's held-out rms / noise floor
   double floor = 0.0;                              // the gain it must reach (criteria.hpp gain_floor)
   std::string reason;                              // empty: passes
+  std::map<std::string, double> form_costs;        // per form tried (EffectSpec::forms)
 };
+
+// ------------------------------------------------------------ tuning
+// The engine's numbers, each named once (docs/diagnosis.md 4-5 say why).
+
+// Levenberg-Marquardt iterations of the fits that run to convergence: the
+// baseline's calibration (twice, at the nominal and the calibrated prior
+// weight) and the backward check; a refit starts from its screening, nearer.
+constexpr int kCalibrationIterations = 60;
+constexpr int kRefitIterations = 30;
+constexpr int kBackwardCheckIterations = 60;
+// A strength parameter this many standard deviations from its null is significant.
+constexpr double kSignificantSigmas = 3.0;
+// The gain's standard error: a block bootstrap of the held-out part, this
+// many resamples of kBootstrapBlocks sub-blocks (fixed seed: the verdict does
+// not change between runs of the same record).
+constexpr int kGainResamples = 200;
+constexpr unsigned kGainSeed = 777;
+constexpr std::size_t kBootstrapBlocks = 10;
+// The confidence: the share of this many resamples the winner wins.
+constexpr int kConfidenceResamples = 400;
+constexpr unsigned kConfidenceSeed = 12345;
+// A candidate with fewer parameters wins a near tie: within this many pp of
+// the winner's gain, or this share of it if larger.
+constexpr double kNearTiePoints = 0.5;
+constexpr double kNearTieShare = 0.1;
+// A parameter that stands for a cause ended at its band's edge when it is
+// within this share of a tolerance of it.
+constexpr double kBandEdgeShare = 0.05;
+// Iterations of a candidate's refit in each of its forms: enough to rank
+// the forms from the screened start.
+constexpr int kFormIterations = 6;
 
 // ------------------------------------------------------------ calibration
 
@@ -48,10 +80,10 @@ Scored calibrate_baseline(Workspace& w, Diagnosis& d) {
   const Scored nominal = w.score(w.theta_null());
   w.prior_weight = w.residual_variance(nominal);
   const auto free = w.free_for({});
-  Scored base = w.fit(nominal.theta, free, 60, false);
+  Scored base = w.fit(nominal.theta, free, kCalibrationIterations, false);
   const int first_iterations = base.iterations;
   w.prior_weight = w.residual_variance(base);
-  base = w.fit(base.theta, free, 60, true);
+  base = w.fit(base.theta, free, kCalibrationIterations, true);
   w.say("calibrated in " + std::to_string(first_iterations) + " + " + std::to_string(base.iterations) +
         " iterations");
   for (std::size_t i = 0; i < w.n_base; ++i) {
@@ -60,11 +92,13 @@ Scored calibrate_baseline(Workspace& w, Diagnosis& d) {
                  false};
     c.moved = sp.prior > 0.0 && std::abs(c.value - c.nominal) >= 0.5 * sp.prior * std::abs(c.nominal);
     if (!sp.stands_for.empty()) {
-      // Within a twentieth of a tolerance of the edge the workspace set.
       const double edge = sp.toward < 0 ? sp.lo : sp.hi;
       c.stands_for = sp.stands_for;
-      c.at_band_edge = std::abs(c.value - edge) <= 0.05 * sp.prior * std::abs(c.nominal);
+      c.at_band_edge = std::abs(c.value - edge) <= kBandEdgeShare * sp.prior * std::abs(c.nominal);
     }
+    c.timing = sp.timing;
+    c.lo = sp.lo;
+    c.hi = sp.hi;
     d.calibration.push_back(c);
     d.baseline_parameters.push_back({sp.name, sp.unit, c.value, c.sigma, c.determined});
   }
@@ -157,7 +191,7 @@ std::vector<Candidate> screen(const Workspace& w, const Scored& current, const s
   for (std::size_t e = 0; e < w.effects.size(); ++e)
     if (!w.effects[e].stub && std::find(active.begin(), active.end(), e) == active.end()) todo.push_back(e);
   std::vector<Candidate> out(todo.size());
-  parallel_for(todo.size(), [&](std::size_t k, std::size_t) {
+  parallel_for(w.threads, todo.size(), [&](std::size_t k, std::size_t) {
     const std::size_t e = todo[k];
     w.say("round " + std::to_string(round) + ": screening " + w.effects[e].cause);
     std::vector<bool> free = coupled_free(w, {e});
@@ -193,26 +227,50 @@ bool strength_significant(const Workspace& w, std::size_t e, const Scored& s) {
   for (std::size_t j = 0; j < w.effects[e].params.size(); ++j) {
     const auto& ps = w.effects[e].params[j];
     const double val = s.theta[w.offset[e] + j], sg = s.sigma[w.offset[e] + j];
-    if (ps.strength && std::isfinite(sg) && std::abs(val - ps.null) >= 3.0 * sg) return true;
+    if (ps.strength && std::isfinite(sg) && std::abs(val - ps.null) >= kSignificantSigmas * sg) return true;
   }
   return false;
 }
 
+// A candidate of several forms (EffectSpec::forms): its parameters and the
+// baseline's it couples to refitted briefly in each form from `start`, the
+// form with the lowest estimation cost returned as a start for its refit
+// (`start` itself where that is the form it has). Its own parameters alone were not
+// enough: the screened baseline had bent to the first form (a Bessel filter
+// was taken for one of order 3). One form: the start unchanged.
+std::vector<double> best_form(const Workspace& w, std::size_t e, std::vector<double> start,
+                              std::map<std::string, double>& costs) {
+  const auto& eff = w.effects[e];
+  std::size_t form = eff.params.size();
+  for (std::size_t j = 0; j < eff.params.size(); ++j)
+    if (eff.params[j].form) form = j;
+  if (form == eff.params.size() || eff.forms.size() < 2) return start;
+  const std::vector<bool> own = coupled_free(w, {e});
+  std::vector<Scored> fits(eff.forms.size());
+  parallel_for(w.threads, fits.size(), [&](std::size_t f, std::size_t) {
+    auto s = start;
+    s[w.offset[e] + form] = static_cast<double>(f);
+    fits[f] = w.fit(s, own, kFormIterations, false);
+  });
+  std::size_t best = 0;
+  for (std::size_t f = 0; f < fits.size(); ++f) {
+    costs[eff.forms[f]] = fits[f].est_sse;
+    if (fits[f].est_sse < fits[best].est_sse) best = f;
+  }
+  w.say("  " + eff.cause + ": form " + eff.forms[best] + " fits best");
+  if (static_cast<double>(best) == start[w.offset[e] + form]) return start;  // the form it has
+  return fits[best].theta;
+}
+
 // Full refit of one screened candidate, judged against the current model
 // (every candidate of the round at the same N_eff, neff).
-Candidate refit_one(const Workspace& w, const Candidate& screened, const Scored& current,
-                    const std::vector<std::size_t>& active, double neff, int round) {
-  Candidate r;
-  r.effect = screened.effect;
+// Judges the refitted candidate r (r.effect and r.s set) against the current
+// model: its signal, gain and standard error, and the gates' verdict.
+void judge(const Workspace& w, Candidate& r, const Scored& current, const std::vector<std::size_t>& active,
+           double neff) {
   const std::string& cause = w.effects[r.effect].cause;
-  w.say("round " + std::to_string(round) + ": refitting " + cause);
   auto act = active;
   act.push_back(r.effect);
-  // The baseline parameters the kept and the new effects couple to are
-  // free; the others stay where the calibration put them (their
-  // sub-model's outputs do not change with the candidate).
-  r.s = fit_coupled(w, screened.s.theta, act, 30, current);
-  w.say("  " + cause + ": refitted in " + std::to_string(r.s.iterations) + " iterations");
   // Its signal: the largest gain among the outputs where it reaches its
   // floor (a delay may gain most on dp but explain the misfit of theta),
   // else the largest gain.
@@ -226,8 +284,9 @@ Candidate refit_one(const Workspace& w, const Candidate& screened, const Scored&
   }
   const auto& sig = r.signal;
   r.gain = ev.gain;
-  const auto fits = bootstrap_fits(w.outs()[sig].measured, {&current.y[sig], &r.s.y[sig]}, w.val_begin, w.n, 200,
-                                   777, 10, activity_strata(current.y[sig], r.s.y[sig], w.val_begin, w.n));
+  const auto fits = bootstrap_fits(w.outs()[sig].measured, {&current.y[sig], &r.s.y[sig]}, w.val_begin, w.n,
+                                   kGainResamples, kGainSeed, kBootstrapBlocks,
+                                   activity_strata(current.y[sig], r.s.y[sig], w.val_begin, w.n, kBootstrapBlocks));
   r.se = ev.se = gain_standard_error(fits, 1, 0);
   // Parsimony on the outputs the candidate acts on (RigModel::acts_on): a
   // sub-model's effect is not judged against the other sub-model's misfit
@@ -243,7 +302,37 @@ Candidate refit_one(const Workspace& w, const Candidate& screened, const Scored&
   r.excess_before = ev.excess_before;
   r.excess_after = ev.excess_after;
   r.floor = gain_floor(ev, w.options);
-  return r;
+}
+
+// Full refit of one screened candidate, judged against the current model
+// (every candidate of the round at the same N_eff, neff). A candidate of
+// several forms is refitted in its first form; only where that reaches its
+// gain floor are its forms ranked (best_form) and, where another fits
+// better, refitted in that one and judged again: the forms are what the
+// JSON reports of a named cause, and ranking them for every candidate that
+// is then rejected doubled a quarter-car round.
+Candidate refit_one(const Workspace& w, const Candidate& screened, const Scored& current,
+                    const std::vector<std::size_t>& active, double neff, int round) {
+  Candidate r;
+  r.effect = screened.effect;
+  const std::string& cause = w.effects[r.effect].cause;
+  w.say("round " + std::to_string(round) + ": refitting " + cause);
+  auto act = active;
+  act.push_back(r.effect);
+  // The baseline parameters the kept and the new effects couple to are
+  // free; the others stay where the calibration put them (their
+  // sub-model's outputs do not change with the candidate).
+  r.s = fit_coupled(w, screened.s.theta, act, kRefitIterations, current);
+  w.say("  " + cause + ": refitted in " + std::to_string(r.s.iterations) + " iterations");
+  judge(w, r, current, active, neff);
+  if (w.effects[r.effect].forms.size() < 2 || r.gain < r.floor) return r;
+  const auto start = best_form(w, r.effect, r.s.theta, r.form_costs);
+  if (start == r.s.theta) return r;
+  Candidate other = r;
+  other.s = fit_coupled(w, start, act, kRefitIterations, current);
+  if (!(other.s.est_sse < r.s.est_sse)) return r;
+  judge(w, other, current, active, neff);
+  return other;
 }
 
 // Full refit of the best few, side by side on the workers (they are
@@ -256,7 +345,7 @@ std::vector<Candidate> refit_best(const Workspace& w, std::vector<Candidate> scr
   const std::size_t top =
       std::min(screened.size(), static_cast<std::size_t>(std::max(0, w.options.refit_top)) + extra);
   std::vector<Candidate> refits(top);
-  parallel_for(top, [&](std::size_t c, std::size_t) { refits[c] = refit_one(w, screened[c], current, active, neff, round); });
+  parallel_for(w.threads, top, [&](std::size_t c, std::size_t) { refits[c] = refit_one(w, screened[c], current, active, neff, round); });
   for (std::size_t c = 0; c < screened.size(); ++c) {
     ScreenedCandidate sc;
     sc.cause = w.effects[screened[c].effect].cause;
@@ -300,7 +389,7 @@ const Candidate* choose(const Workspace& w, const std::vector<Candidate>& refits
   for (const auto& r : refits)
     if (r.reason.empty() && (!win || r.gain > win->gain)) win = &r;
   if (!win) return nullptr;
-  const double margin = std::max(0.5, 0.1 * win->gain);
+  const double margin = std::max(kNearTiePoints, kNearTieShare * win->gain);
   for (const auto& r : refits)
     if (r.reason.empty() && r.gain >= win->gain - margin &&
         w.effects[r.effect].params.size() < w.effects[win->effect].params.size())
@@ -319,7 +408,8 @@ double confidence(const Workspace& w, const Candidate& win, const std::vector<Ca
     if (&refits[r] == &win) wi = r + 1;
     sims.push_back(&refits[r].s.y[win.signal]);
   }
-  const auto fits = bootstrap_fits(w.outs()[win.signal].measured, sims, w.val_begin, w.n, 400, 12345);
+  const auto fits = bootstrap_fits(w.outs()[win.signal].measured, sims, w.val_begin, w.n, kConfidenceResamples,
+                                   kConfidenceSeed, kBootstrapBlocks);
   int wins = 0;
   for (const auto& row : fits) {
     std::size_t best = 1;
@@ -328,6 +418,25 @@ double confidence(const Workspace& w, const Candidate& win, const std::vector<Ca
     if (best == wi && row[best] - row[0] >= win.floor) ++wins;
   }
   return static_cast<double>(wins) / static_cast<double>(fits.size());
+}
+
+// The sensor channels an effect's parameters showed: those more than
+// kSignificantSigmas from their null; none such, the largest departure's.
+std::vector<std::string> showed_channels(const Workspace& w, std::size_t e, const Scored& s) {
+  std::vector<std::string> out;
+  const auto& params = w.effects[e].params;
+  std::string largest;
+  double most = 0.0;
+  for (std::size_t j = 0; j < params.size(); ++j) {
+    if (params[j].channel.empty()) continue;
+    const std::size_t i = w.offset[e] + j;
+    const double dep = std::abs(s.theta[i] - params[j].null);
+    if (std::isfinite(s.sigma[i]) && dep >= kSignificantSigmas * s.sigma[i] && dep > 0.0)
+      out.push_back(params[j].channel);
+    if (dep > most) most = dep, largest = params[j].channel;
+  }
+  if (out.empty() && !largest.empty()) out.push_back(largest);
+  return out;
 }
 
 CauseResult describe(const Workspace& w, const Candidate& win, const std::vector<Candidate>& refits,
@@ -345,9 +454,16 @@ CauseResult describe(const Workspace& w, const Candidate& win, const std::vector
       cr.ambiguous_with.push_back(w.effects[r.effect].cause);
   for (std::size_t j = 0; j < eff.params.size(); ++j) {
     const std::size_t i = w.offset[win.effect] + j;
+    if (eff.params[j].form) {
+      cr.form = eff.forms.empty() ? "" : eff.forms[static_cast<std::size_t>(std::clamp<long>(
+                                             std::lround(win.s.theta[i]), 0, static_cast<long>(eff.forms.size()) - 1))];
+      continue;
+    }
     cr.parameters.push_back({eff.params[j].name, eff.params[j].unit, win.s.theta[i], win.s.sigma[i],
-                             !win.s.undetermined[i]});
+                             !win.s.undetermined[i], eff.params[j].channel});
   }
+  cr.form_costs = win.form_costs;
+  cr.channels = showed_channels(w, win.effect, win.s);
   const auto ind = w.model.indicator(cr.cause);
   const auto before = w.residual(current, win.signal);
   const double dt = w.n > 1 ? (w.model.time().back() - w.model.time().front()) / static_cast<double>(w.n - 1) : 1.0;
@@ -398,7 +514,7 @@ void backward_check(const Workspace& w, std::vector<std::size_t>& active, Scored
     const auto& eff = w.effects[active[k]];
     for (std::size_t j = 0; j < eff.params.size(); ++j) start[w.offset[active[k]] + j] = eff.params[j].null;
     w.say("backward check: without " + eff.cause);
-    const Scored without = fit_coupled(w, start, others, 60, current);
+    const Scored without = fit_coupled(w, start, others, kBackwardCheckIterations, current);
     double best = -1e9;
     bool earns = false;
     for (std::size_t o = 0; o < w.outs().size(); ++o) {
@@ -453,14 +569,19 @@ void finish(const Workspace& w, const std::vector<std::size_t>& active, const Sc
   // Each named cause reports its parameters from the final joint fit: the
   // round that accepted it ran without the effects added later.
   for (auto& cr : d.causes)
-    for (auto e : active)
-      if (w.effects[e].cause == cr.cause)
-        for (std::size_t j = 0; j < cr.parameters.size(); ++j) {
+    for (auto e : active) {
+      if (w.effects[e].cause != cr.cause) continue;
+      const auto& params = w.effects[e].params;
+      for (auto& pv : cr.parameters)
+        for (std::size_t j = 0; j < params.size(); ++j) {
+          if (params[j].name != pv.name) continue;
           const std::size_t i = w.offset[e] + j;
-          cr.parameters[j].value = current.theta[i];
-          if (!current.sigma.empty()) cr.parameters[j].sigma = current.sigma[i];
-          if (!current.undetermined.empty()) cr.parameters[j].determined = !current.undetermined[i];
+          pv.value = current.theta[i];
+          if (!current.sigma.empty()) pv.sigma = current.sigma[i];
+          if (!current.undetermined.empty()) pv.determined = !current.undetermined[i];
         }
+      if (!current.sigma.empty()) cr.channels = showed_channels(w, e, current);
+    }
   for (std::size_t o = 0; o < w.outs().size(); ++o) {
     d.baseline_fit_percent[w.outs()[o].name] = base.fit[o];
     d.extended_fit_percent[w.outs()[o].name] = current.fit[o];

@@ -23,6 +23,7 @@ struct ParamValue {
   double value = 0.0;
   double sigma = 0.0;
   bool determined = true;  // false: the run cannot determine it; the JSON writes null and lists it as undetermined
+  std::string channel = {};  // the sensor channel it acts on (ParamSpec::channel), or empty
 };
 
 // A baseline parameter after the calibration: where it started (the
@@ -38,6 +39,9 @@ struct Calibrated {
   // asked for more: evidence for that cause, which its candidate must earn).
   std::string stands_for;
   bool at_band_edge = false;
+  // A parameter of the loop's I/O timing (ParamSpec::timing) and its bounds.
+  bool timing = false;
+  double lo = 0.0, hi = 0.0;
 };
 
 struct CauseResult {
@@ -54,6 +58,13 @@ struct CauseResult {
   // Whether the cause enters where the baseline's misfit is (where.hpp
   // where_agrees); false flags a cause named at another place.
   bool where_agrees = true;
+  // A candidate of several forms (EffectSpec::forms): the one that fitted
+  // best, and the estimation cost of each form tried.
+  std::string form;
+  std::map<std::string, double> form_costs;
+  // The sensor channels its parameters showed (ParamSpec::channel): those
+  // more than 3 standard deviations from their null.
+  std::vector<std::string> channels;
 };
 
 struct ScreenedCandidate {
@@ -127,6 +138,9 @@ struct DiagnoseOptions {
   // whole leakage, trended over windows; whether it changed is the change
   // detector's question over many windows, not one window's gates.
   bool calibration_only = false;
+  // Threads of the whole diagnosis, the calling one included (--threads):
+  // its nested parallel loops share them (parallel.hpp ThreadBudget).
+  int threads = 2;
   std::ostream* progress = nullptr;  // stderr in the program
 };
 

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <vector>
 
 #include "tools/diagnosis/parallel.hpp"
 
@@ -17,8 +18,38 @@ namespace rigctl::diag {
 
 namespace {
 
+// One past the last sample a fit scores: its replays need go no further.
+std::size_t mask_horizon(const std::vector<unsigned char>& mask) {
+  std::size_t h = mask.size();
+  while (h > 0 && !mask[h - 1]) --h;
+  return h;
+}
+
+// Fit tolerances: Ceres stops when a step changes the cost or the scaled
+// parameters by less than this relative amount. The scores compared
+// afterwards are fit percents to 0.01 pp, far coarser.
+constexpr double kFitTolerance = 1e-8;
+// The Jacobian's finite-difference step, relative to a scaled parameter's
+// magnitude (at least kStepFloor of its scale): large enough for a replay
+// with switching friction, small against any step the optimiser takes.
+constexpr double kRelativeStep = 1e-4;
+constexpr double kStepFloor = 0.05;
+// A weighted residual is clipped to this (a diverging replay must not
+// overflow the cost); a non-finite one counts as it.
+constexpr double kResidualClip = 1e6;
+// Directions of J^T J with eigenvalues below this share of the largest are
+// not identifiable (their parameters get an infinite sigma), and a parameter
+// whose share of such a direction's eigenvector exceeds kFlatLoading lies in it.
+constexpr double kFlatEigenvalue = 1e-10;
+constexpr double kFlatLoading = 0.1;
+// With a prior, a parameter is undetermined when its posterior is not
+// narrower than this share of the prior (docs/diagnosis.md 4).
+constexpr double kDeterminedShare = 0.7;
+
+// The output-error residuals at scaled parameters z: the weighted data
+// residuals on the mask, then one residual per free parameter with a prior.
 struct Residuals {
-  const FitProblem* p;
+  const FitProblem* p = nullptr;
   std::vector<int> free_index;
   std::vector<int> prior_index;  // free parameters with a prior (one residual each, after the data)
   std::size_t count = 0;
@@ -44,7 +75,7 @@ struct Residuals {
       for (std::size_t i = 0; i < m.size(); ++i) {
         if (!p->mask[i]) continue;
         const double e = (y[o][i] - m[i]) * p->weight[o];
-        r[k++] = std::isfinite(e) ? std::clamp(e, -1e6, 1e6) : 1e6;
+        r[k++] = std::isfinite(e) ? std::clamp(e, -kResidualClip, kResidualClip) : kResidualClip;
       }
     }
     const double w = std::sqrt(std::max(0.0, p->prior_weight));
@@ -65,8 +96,8 @@ struct Residuals {
 // strength test.
 class SimCost : public ceres::CostFunction {
  public:
-  explicit SimCost(const Residuals* r, std::vector<double> lo, std::vector<double> hi)
-      : r_(r), lo_(std::move(lo)), hi_(std::move(hi)) {
+  SimCost(const Residuals* r, std::vector<double> lo, std::vector<double> hi, ThreadBudget* threads)
+      : r_(r), lo_(std::move(lo)), hi_(std::move(hi)), threads_(threads) {
     mutable_parameter_block_sizes()->push_back(static_cast<int>(r->free_index.size()));
     set_num_residuals(static_cast<int>(r->count));
   }
@@ -77,45 +108,211 @@ class SimCost : public ceres::CostFunction {
       if (!std::isfinite(params[0][j])) return false;
     r_->eval(params[0], residuals);
     if (jacobians == nullptr || jacobians[0] == nullptr) return true;
-    const std::size_t m = r_->count;
-    auto column = [&](std::size_t j, std::vector<double>& rp, std::vector<double>& rm) {
-      std::vector<double> z(params[0], params[0] + nf);
-      const double h = 1e-4 * std::max(std::abs(z[j]), 0.05);
-      double a = std::min(z[j] + h, hi_[j]), b = z[j];
-      if (central_) {
-        b = std::max(z[j] - h, lo_[j]);
-      } else if (a <= z[j]) {  // at the upper bound: a backward difference
-        a = z[j];
-        b = std::max(z[j] - h, lo_[j]);
-      }
-      const double* fa = residuals;
-      const double* fb = residuals;
-      if (a != z[j]) {
-        z[j] = a;
-        r_->eval(z.data(), rp.data());
-        fa = rp.data();
-      }
-      if (b != params[0][j]) {
-        z[j] = b;
-        r_->eval(z.data(), rm.data());
-        fb = rm.data();
-      }
-      const double d = a - b;
-      for (std::size_t i = 0; i < m; ++i) jacobians[0][i * nf + j] = d > 0 ? (fa[i] - fb[i]) / d : 0.0;
+    // The columns' simulations are independent: they run on the budget's
+    // spare threads (the simulations are const and share nothing), each
+    // worker with its own buffers.
+    const std::size_t workers = threads_ ? threads_->threads() : 1;
+    std::vector<std::vector<double>> rp(workers), rm(workers);
+    auto column = [&](std::size_t j, std::size_t worker) {
+      rp[worker].resize(r_->count);
+      rm[worker].resize(r_->count);
+      this->column(params[0], residuals, j, rp[worker], rm[worker], jacobians[0]);
     };
-    // The columns' simulations are independent: they run on the workers
-    // (the simulations are const and share nothing), each with its own
-    // buffers.
-    std::vector<std::vector<double>> rp(kDiagnosisWorkers, std::vector<double>(m)), rm = rp;
-    parallel_for(nf, [&](std::size_t j, std::size_t worker) { column(j, rp[worker], rm[worker]); });
+    if (threads_) {
+      parallel_for(*threads_, nf, column);
+    } else {
+      for (std::size_t j = 0; j < nf; ++j) column(j, 0);
+    }
     return true;
   }
 
  private:
+  // Column j of the Jacobian (row-major, nf columns) at z, whose residuals are f0.
+  void column(const double* z0, const double* f0, std::size_t j, std::vector<double>& rp, std::vector<double>& rm,
+              double* jac) const {
+    const std::size_t nf = r_->free_index.size();
+    std::vector<double> z(z0, z0 + nf);
+    const double h = kRelativeStep * std::max(std::abs(z[j]), kStepFloor);
+    double a = std::min(z[j] + h, hi_[j]), b = z[j];
+    if (central_) {
+      b = std::max(z[j] - h, lo_[j]);
+    } else if (a <= z[j]) {  // at the upper bound: a backward difference
+      a = z[j];
+      b = std::max(z[j] - h, lo_[j]);
+    }
+    const double* fa = f0;
+    const double* fb = f0;
+    if (a != z0[j]) {
+      z[j] = a;
+      r_->eval(z.data(), rp.data());
+      fa = rp.data();
+    }
+    if (b != z0[j]) {
+      z[j] = b;
+      r_->eval(z.data(), rm.data());
+      fb = rm.data();
+    }
+    const double d = a - b;
+    for (std::size_t i = 0; i < r_->count; ++i) jac[i * nf + j] = d > 0 ? (fa[i] - fb[i]) / d : 0.0;
+  }
+
   const Residuals* r_;
   std::vector<double> lo_, hi_;
+  ThreadBudget* threads_;
   bool central_ = false;
 };
+
+// One output-error fit in its three parts: the problem's set-up (which
+// parameters are free, their scaled start and bounds, the residuals), the
+// solve, and the covariance at the optimum. The object owns everything Ceres
+// is handed (the problem does not take ownership), so it is neither copied
+// nor moved.
+class OutputErrorFit {
+ public:
+  explicit OutputErrorFit(const FitProblem& p);
+  OutputErrorFit(const OutputErrorFit&) = delete;
+  OutputErrorFit& operator=(const OutputErrorFit&) = delete;
+
+  std::size_t free_count() const { return res_.free_index.size(); }
+  // Levenberg-Marquardt from the start; theta, cost and iterations of `out`.
+  void solve(FitResult& out);
+  // sigma and the undetermined flags of `out`, at out.theta.
+  void covariance(FitResult& out);
+
+ private:
+  double residual_scale(const FitResult& out) const;
+
+  const FitProblem& p_;
+  Residuals res_;
+  std::vector<double> z_, zlo_, zhi_;  // scaled parameters and bounds (1e30: none)
+  std::unique_ptr<SimCost> cost_;
+  std::unique_ptr<ceres::Problem> problem_;
+};
+
+OutputErrorFit::OutputErrorFit(const FitProblem& p) : p_(p) {
+  res_.p = &p;
+  for (std::size_t i = 0; i < p.specs.size(); ++i)
+    if (p.free[i]) {
+      res_.free_index.push_back(static_cast<int>(i));
+      if (p.specs[i].prior > 0.0 && p.specs[i].init != 0.0 && p.prior_weight > 0.0)
+        res_.prior_index.push_back(static_cast<int>(i));
+    }
+  const std::size_t masked = static_cast<std::size_t>(std::count_if(p.mask.begin(), p.mask.end(), [](auto m) { return m != 0; }));
+  res_.count = masked * p.model->outputs().size() + res_.prior_index.size();
+  res_.horizon = mask_horizon(p.mask);
+  const std::size_t nf = free_count();
+  if (nf == 0) return;
+  z_.resize(nf);
+  zlo_.resize(nf);
+  zhi_.resize(nf);
+  for (std::size_t j = 0; j < nf; ++j) {
+    const auto& sp = p.specs[static_cast<std::size_t>(res_.free_index[j])];
+    z_[j] = p.theta0[static_cast<std::size_t>(res_.free_index[j])] / sp.scale;
+    zlo_[j] = sp.lo > -1e29 ? sp.lo / sp.scale : -1e30;
+    zhi_[j] = sp.hi < 1e29 ? sp.hi / sp.scale : 1e30;
+  }
+  cost_ = std::make_unique<SimCost>(&res_, zlo_, zhi_, p.threads);
+  ceres::Problem::Options popt;
+  popt.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_ = std::make_unique<ceres::Problem>(popt);
+  problem_->AddResidualBlock(cost_.get(), nullptr, z_.data());
+  for (std::size_t j = 0; j < nf; ++j) {
+    if (zlo_[j] > -1e29) problem_->SetParameterLowerBound(z_.data(), static_cast<int>(j), zlo_[j]);
+    if (zhi_[j] < 1e29) problem_->SetParameterUpperBound(z_.data(), static_cast<int>(j), zhi_[j]);
+  }
+}
+
+void OutputErrorFit::solve(FitResult& out) {
+  // Ceres logs through glog: keep the terminal for our progress (once: fits
+  // run on several threads).
+  static std::once_flag quiet;
+  std::call_once(quiet, [] { FLAGS_minloglevel = 3; });
+  ceres::Solver::Options opt;
+  opt.linear_solver_type = ceres::DENSE_QR;
+  opt.max_num_iterations = p_.max_iterations;
+  opt.function_tolerance = kFitTolerance;
+  opt.parameter_tolerance = kFitTolerance;
+  opt.num_threads = 1;  // the Jacobian's columns are parallel in SimCost, from the diagnosis's budget
+  opt.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(opt, problem_.get(), &summary);
+  out.cost = summary.final_cost;
+  out.iterations = static_cast<int>(summary.iterations.size());
+  for (std::size_t j = 0; j < free_count(); ++j) {
+    const auto i = static_cast<std::size_t>(res_.free_index[j]);
+    out.theta[i] = z_[j] * p_.specs[i].scale;
+  }
+}
+
+// The residual variance per degree of freedom at the optimum, inflated for
+// the colour of the first output's residual (N / N_eff): the covariance's scale.
+double OutputErrorFit::residual_scale(const FitResult& out) const {
+  std::vector<std::vector<double>> y;
+  p_.model->simulate_prefix(out.theta, y, res_.horizon);
+  const auto& outs = p_.model->outputs();
+  std::vector<double> first;
+  double data_sse = 0.0;
+  for (std::size_t o = 0; o < outs.size(); ++o)
+    for (std::size_t i = 0; i < outs[o].measured.size(); ++i)
+      if (p_.mask[i]) {
+        const double e = (y[o][i] - outs[o].measured[i]) * p_.weight[o];
+        if (o == 0) first.push_back(e);
+        if (std::isfinite(e)) data_sse += e * e;
+      }
+  const double n_data = static_cast<double>(res_.count - res_.prior_index.size());
+  const double dof = std::max(1.0, n_data - static_cast<double>(free_count()));
+  return data_sse / dof / effective_fraction(first);
+}
+
+// (J^T J)^-1 by eigen-decomposition from the central-difference Jacobian at
+// the optimum, scaled by the residual variance; directions with eigenvalues
+// below kFlatEigenvalue of the largest are not identifiable.
+void OutputErrorFit::covariance(FitResult& out) {
+  const std::size_t nf = free_count();
+  const double s2 = residual_scale(out);
+  double cost_now = 0.0;
+  ceres::CRSMatrix J;
+  cost_->set_central(true);
+  problem_->Evaluate(ceres::Problem::EvaluateOptions(), &cost_now, nullptr, nullptr, &J);
+  const auto dim = static_cast<Eigen::Index>(nf);
+  Eigen::MatrixXd JtJ = Eigen::MatrixXd::Zero(dim, dim);
+  for (int row = 0; row < J.num_rows; ++row)
+    for (int a1 = J.rows[row]; a1 < J.rows[row + 1]; ++a1)
+      for (int b1 = J.rows[row]; b1 < J.rows[row + 1]; ++b1) JtJ(J.cols[a1], J.cols[b1]) += J.values[a1] * J.values[b1];
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(JtJ);
+  const auto& ev = es.eigenvalues();
+  const double top = ev.size() ? ev.maxCoeff() : 0.0;
+  auto flat = [&](Eigen::Index k) { return !(ev(k) > kFlatEigenvalue * top) || !std::isfinite(ev(k)); };
+  Eigen::MatrixXd C = Eigen::MatrixXd::Zero(dim, dim);
+  for (Eigen::Index k = 0; k < ev.size(); ++k) {
+    if (flat(k)) {
+      out.rank_deficient = true;
+      continue;
+    }
+    C += es.eigenvectors().col(k) * es.eigenvectors().col(k).transpose() / ev(k);
+  }
+  for (std::size_t j = 0; j < nf; ++j) {
+    const auto i = static_cast<std::size_t>(res_.free_index[j]);
+    const auto jj = static_cast<Eigen::Index>(j);
+    bool weak = false;
+    for (Eigen::Index k = 0; k < ev.size(); ++k)
+      if (flat(k) && std::abs(es.eigenvectors()(jj, k)) > kFlatLoading) weak = true;
+    out.sigma[i] = weak ? std::numeric_limits<double>::infinity()
+                        : std::sqrt(std::max(0.0, C(jj, jj) * s2)) * p_.specs[i].scale;
+    // With a prior the posterior is always finite: the run did not determine
+    // the parameter when it is hardly narrower than the prior. The prior rows
+    // carry prior_weight, not s2, so the prior's own width is rescaled.
+    const auto& sp = p_.specs[i];
+    const bool has_prior = std::find(res_.prior_index.begin(), res_.prior_index.end(), static_cast<int>(i)) !=
+                           res_.prior_index.end();
+    if (has_prior) {
+      const double prior_sd = sp.prior * std::abs(sp.init) * std::sqrt(s2 / p_.prior_weight);
+      out.undetermined[i] = !(out.sigma[i] < kDeterminedShare * prior_sd);
+    } else {
+      out.undetermined[i] = !std::isfinite(out.sigma[i]);
+    }
+  }
+}
 
 }  // namespace
 
@@ -142,13 +339,6 @@ double effective_fraction(const std::vector<double>& r) {
   return 1.0 / (1.0 + 2.0 * sum);
 }
 
-// One past the last sample a fit scores: its replays need go no further.
-std::size_t mask_horizon(const std::vector<unsigned char>& mask) {
-  std::size_t h = mask.size();
-  while (h > 0 && !mask[h - 1]) --h;
-  return h;
-}
-
 double weighted_sse(const RigModel& model, const std::vector<double>& theta, const std::vector<unsigned char>& mask,
                     const std::vector<double>& weight) {
   std::vector<std::vector<double>> y;
@@ -159,141 +349,23 @@ double weighted_sse(const RigModel& model, const std::vector<double>& theta, con
     for (std::size_t i = 0; i < outs[o].measured.size(); ++i)
       if (mask[i]) {
         const double e = (y[o][i] - outs[o].measured[i]) * weight[o];
-        s += std::isfinite(e) ? e * e : 1e12;
+        s += std::isfinite(e) ? e * e : kResidualClip * kResidualClip;
       }
   return s;
 }
 
 FitResult fit_output_error(const FitProblem& p, bool with_covariance) {
-  auto* res = new Residuals;
-  res->p = &p;
-  for (std::size_t i = 0; i < p.specs.size(); ++i)
-    if (p.free[i]) {
-      res->free_index.push_back(static_cast<int>(i));
-      if (p.specs[i].prior > 0.0 && p.specs[i].init != 0.0 && p.prior_weight > 0.0)
-        res->prior_index.push_back(static_cast<int>(i));
-    }
-  std::size_t masked = 0;
-  for (auto m : p.mask) masked += m ? 1 : 0;
-  res->count = masked * p.model->outputs().size() + res->prior_index.size();
-  res->horizon = mask_horizon(p.mask);
-
   FitResult out;
   out.theta = p.theta0;
   out.sigma.assign(p.specs.size(), 0.0);
   out.undetermined.assign(p.specs.size(), false);
-  const std::size_t nf = res->free_index.size();
-  std::unique_ptr<Residuals> owner(res);
-  if (nf == 0) {
+  OutputErrorFit fit(p);
+  if (fit.free_count() == 0) {
     out.cost = 0.5 * weighted_sse(*p.model, p.theta0, p.mask, p.weight);
     return out;
   }
-  std::vector<double> z(nf);
-  for (std::size_t j = 0; j < nf; ++j) {
-    const auto i = static_cast<std::size_t>(res->free_index[j]);
-    z[j] = p.theta0[i] / p.specs[i].scale;
-  }
-  const std::vector<int> free_index = res->free_index;
-  const std::size_t count = res->count;
-
-  std::vector<double> zlo(nf), zhi(nf);
-  for (std::size_t j = 0; j < nf; ++j) {
-    const auto& sp = p.specs[static_cast<std::size_t>(free_index[j])];
-    zlo[j] = sp.lo > -1e29 ? sp.lo / sp.scale : -1e30;
-    zhi[j] = sp.hi < 1e29 ? sp.hi / sp.scale : 1e30;
-  }
-  auto* cost = new SimCost(res, zlo, zhi);
-  // Ceres logs through glog: keep the terminal for our progress (once: fits
-  // run on several threads).
-  static std::once_flag quiet;
-  std::call_once(quiet, [] { FLAGS_minloglevel = 3; });
-  ceres::Problem::Options popt;
-  popt.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  ceres::Problem problem(popt);
-  std::unique_ptr<SimCost> cost_owner(cost);
-  problem.AddResidualBlock(cost, nullptr, z.data());
-  for (std::size_t j = 0; j < nf; ++j) {
-    const auto& s = p.specs[static_cast<std::size_t>(free_index[j])];
-    if (s.lo > -1e29) problem.SetParameterLowerBound(z.data(), static_cast<int>(j), s.lo / s.scale);
-    if (s.hi < 1e29) problem.SetParameterUpperBound(z.data(), static_cast<int>(j), s.hi / s.scale);
-  }
-  ceres::Solver::Options opt;
-  opt.linear_solver_type = ceres::DENSE_QR;
-  opt.max_num_iterations = p.max_iterations;
-  opt.function_tolerance = 1e-8;
-  opt.parameter_tolerance = 1e-8;
-  opt.num_threads = 1;
-  opt.logging_type = ceres::SILENT;
-  ceres::Solver::Summary summary;
-  ceres::Solve(opt, &problem, &summary);
-  out.cost = summary.final_cost;
-  out.iterations = static_cast<int>(summary.iterations.size());
-  for (std::size_t j = 0; j < nf; ++j) {
-    const auto i = static_cast<std::size_t>(free_index[j]);
-    out.theta[i] = z[j] * p.specs[i].scale;
-  }
-  if (!with_covariance) return out;
-
-  // Residual variance and colour for the covariance scaling.
-  std::vector<std::vector<double>> y;
-  p.model->simulate_prefix(out.theta, y, res->horizon);
-  std::vector<double> r;
-  const auto& m0 = p.model->outputs()[0].measured;
-  for (std::size_t i = 0; i < m0.size(); ++i)
-    if (p.mask[i]) r.push_back((y[0][i] - m0[i]) * p.weight[0]);
-  double data_sse = 0.0;
-  for (std::size_t o = 0; o < p.model->outputs().size(); ++o)
-    for (std::size_t i = 0; i < m0.size(); ++i)
-      if (p.mask[i]) {
-        const double e = (y[o][i] - p.model->outputs()[o].measured[i]) * p.weight[o];
-        if (std::isfinite(e)) data_sse += e * e;
-      }
-  const double n_data = static_cast<double>(count - res->prior_index.size());
-  const double dof = std::max(1.0, n_data - static_cast<double>(nf));
-  const double s2 = data_sse / dof / effective_fraction(r);
-
-  // Covariance from the Jacobian at the optimum: (J^T J)^-1 by eigen-decomposition;
-  // directions with eigenvalues below 1e-10 of the largest are not identifiable.
-  double cost_now = 0.0;
-  ceres::CRSMatrix J;
-  cost->set_central(true);
-  problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost_now, nullptr, nullptr, &J);
-  Eigen::MatrixXd JtJ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(nf), static_cast<Eigen::Index>(nf));
-  for (int row = 0; row < J.num_rows; ++row)
-    for (int a1 = J.rows[row]; a1 < J.rows[row + 1]; ++a1)
-      for (int b1 = J.rows[row]; b1 < J.rows[row + 1]; ++b1) JtJ(J.cols[a1], J.cols[b1]) += J.values[a1] * J.values[b1];
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(JtJ);
-  const auto& ev = es.eigenvalues();
-  const double top = ev.size() ? ev.maxCoeff() : 0.0;
-  Eigen::MatrixXd C = Eigen::MatrixXd::Zero(JtJ.rows(), JtJ.cols());
-  for (Eigen::Index k = 0; k < ev.size(); ++k) {
-    if (!(ev(k) > 1e-10 * top) || !std::isfinite(ev(k))) {
-      out.rank_deficient = true;
-      continue;
-    }
-    C += es.eigenvectors().col(k) * es.eigenvectors().col(k).transpose() / ev(k);
-  }
-  for (std::size_t j = 0; j < nf; ++j) {
-    const auto i = static_cast<std::size_t>(free_index[j]);
-    bool weak = false;
-    for (Eigen::Index k = 0; k < ev.size(); ++k)
-      if (!(ev(k) > 1e-10 * top) && std::abs(es.eigenvectors()(static_cast<Eigen::Index>(j), k)) > 0.1) weak = true;
-    out.sigma[i] = weak ? std::numeric_limits<double>::infinity()
-                        : std::sqrt(std::max(0.0, C(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(j)) * s2)) *
-                              p.specs[i].scale;
-    // With a prior the posterior is always finite: the run did not determine
-    // the parameter when it is hardly narrower than the prior. The prior rows
-    // carry prior_weight, not s2, so the prior's own width is rescaled.
-    const auto& sp = p.specs[i];
-    const bool has_prior = std::find(res->prior_index.begin(), res->prior_index.end(), static_cast<int>(i)) !=
-                           res->prior_index.end();
-    if (has_prior) {
-      const double prior_sd = sp.prior * std::abs(sp.init) * std::sqrt(s2 / p.prior_weight);
-      out.undetermined[i] = !(out.sigma[i] < 0.7 * prior_sd);
-    } else {
-      out.undetermined[i] = !std::isfinite(out.sigma[i]);
-    }
-  }
+  fit.solve(out);
+  if (with_covariance) fit.covariance(out);
   return out;
 }
 

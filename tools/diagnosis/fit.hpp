@@ -10,6 +10,8 @@
 
 namespace rigctl::diag {
 
+class ThreadBudget;
+
 struct FitProblem {
   const RigModel* model = nullptr;
   std::vector<ParamSpec> specs;     // all parameters (baseline + effects), flat
@@ -23,6 +25,9 @@ struct FitProblem {
   // in the units of the weighted output residuals. The engine sets it to the
   // residual variance per effective sample, so the fit is a MAP estimate.
   double prior_weight = 0.0;
+  // The diagnosis's threads (parallel.hpp): the Jacobian's columns borrow the
+  // spare ones. Null: one thread.
+  ThreadBudget* threads = nullptr;
 };
 
 struct FitResult {

@@ -42,6 +42,18 @@ struct ParamSpec {
   // cause's candidate to earn through the gates. Empty: an ordinary one.
   std::string stands_for;
   int toward = 0;
+  // The sensor channel (run-file column) an effect's parameter acts on, e.g.
+  // one sensor's delay: the JSON names the channels whose parameter the run
+  // showed (ParamValue::channel). Empty: none in particular.
+  std::string channel;
+  // The index of the effect's form (EffectSpec::forms), carried in the
+  // parameter vector but never fitted: the engine refits the effect in each
+  // form and keeps the one that fits best.
+  bool form = false;
+  // A baseline parameter of the loop's I/O timing (when the sample is taken,
+  // when the command takes effect): calibrated within its bounds, reported
+  // as the run's `loop_timing`, never a cause (docs/diagnosis.md 4).
+  bool timing = false;
 };
 
 // How far (in tolerances) a parameter that stands for a cause may calibrate
@@ -55,6 +67,9 @@ struct EffectSpec {
   std::string cause;  // contract cause id
   std::vector<ParamSpec> params;
   std::string description;
+  // The physical forms the candidate can take (a pure delay, a Bessel
+  // filter, ...), by the value of its `form` parameter; empty: one form.
+  std::vector<std::string> forms = {};
   bool stub = false;  // true: the candidate exists but cannot change the model yet (reported as such)
 };
 

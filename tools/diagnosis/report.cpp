@@ -83,31 +83,40 @@ std::string json_where(const WhereResult& w) {
   return s + "]}";
 }
 
+// One named cause of the JSON's "causes" list.
+void write_cause_json(const CauseResult& c, std::ostream& out) {
+  out << "    {\"cause\": " << json_string(c.cause) << ", \"confidence\": " << json_number(c.confidence)
+      << ",\n     \"evidence\": " << json_string(c.evidence) << ",\n     \"parameters\": {";
+  // A parameter the run cannot determine is null, not its starting value.
+  for (std::size_t j = 0; j < c.parameters.size(); ++j)
+    out << (j ? ", " : "") << json_string(c.parameters[j].name) << ": "
+        << (c.parameters[j].determined ? json_number(c.parameters[j].value) : std::string("null"));
+  out << "},\n     \"undetermined_parameters\": " << json_names_where(c.parameters, false);
+  out << ",\n     \"parameter_sigma\": {";
+  for (std::size_t j = 0; j < c.parameters.size(); ++j)
+    out << (j ? ", " : "") << json_string(c.parameters[j].name) << ": "
+        << (c.parameters[j].determined ? json_number(c.parameters[j].sigma) : std::string("null"));
+  out << "},\n     \"parameter_units\": {";
+  for (std::size_t j = 0; j < c.parameters.size(); ++j)
+    out << (j ? ", " : "") << json_string(c.parameters[j].name) << ": " << json_string(c.parameters[j].unit);
+  out << "},\n     \"baseline_fit_percent\": " << json_number(c.baseline_fit_percent)
+      << ", \"extended_fit_percent\": " << json_number(c.extended_fit_percent)
+      << ", \"gain_percent_points\": " << json_number(c.gain_percent_points) << ", \"signal\": " << json_string(c.signal)
+      << ",\n     \"ambiguous_with\": " << json_list(c.ambiguous_with) << ", \"signature\": " << json_string(c.signature)
+      << ", \"where_agrees\": " << (c.where_agrees ? "true" : "false");
+  if (!c.channels.empty()) out << ",\n     \"channels\": " << json_list(c.channels);
+  if (!c.form.empty())
+    out << ",\n     \"form\": " << json_string(c.form) << ", \"form_estimation_cost\": " << json_number_map(c.form_costs);
+  out << "}";
+}
+
 }  // namespace
 
 void write_json(const Diagnosis& d, std::ostream& out) {
   out << "{\n  \"rig\": " << json_string(d.rig) << ",\n  \"cause\": " << json_string(d.cause) << ",\n  \"causes\": [";
   for (std::size_t i = 0; i < d.causes.size(); ++i) {
-    const auto& c = d.causes[i];
-    out << (i ? ",\n" : "\n") << "    {\"cause\": " << json_string(c.cause) << ", \"confidence\": " << json_number(c.confidence)
-        << ",\n     \"evidence\": " << json_string(c.evidence) << ",\n     \"parameters\": {";
-    // A parameter the run cannot determine is null, not its starting value.
-    for (std::size_t j = 0; j < c.parameters.size(); ++j)
-      out << (j ? ", " : "") << json_string(c.parameters[j].name) << ": "
-          << (c.parameters[j].determined ? json_number(c.parameters[j].value) : std::string("null"));
-    out << "},\n     \"undetermined_parameters\": " << json_names_where(c.parameters, false);
-    out << ",\n     \"parameter_sigma\": {";
-    for (std::size_t j = 0; j < c.parameters.size(); ++j)
-      out << (j ? ", " : "") << json_string(c.parameters[j].name) << ": "
-          << (c.parameters[j].determined ? json_number(c.parameters[j].sigma) : std::string("null"));
-    out << "},\n     \"parameter_units\": {";
-    for (std::size_t j = 0; j < c.parameters.size(); ++j)
-      out << (j ? ", " : "") << json_string(c.parameters[j].name) << ": " << json_string(c.parameters[j].unit);
-    out << "},\n     \"baseline_fit_percent\": " << json_number(c.baseline_fit_percent)
-        << ", \"extended_fit_percent\": " << json_number(c.extended_fit_percent)
-        << ", \"gain_percent_points\": " << json_number(c.gain_percent_points) << ", \"signal\": " << json_string(c.signal)
-        << ",\n     \"ambiguous_with\": " << json_list(c.ambiguous_with) << ", \"signature\": " << json_string(c.signature)
-        << ", \"where_agrees\": " << (c.where_agrees ? "true" : "false") << "}";
+    out << (i ? ",\n" : "\n");
+    write_cause_json(d.causes[i], out);
   }
   out << (d.causes.empty() ? "],\n" : "\n  ],\n");
   out << "  \"baseline_fit_percent\": " << json_number_map(d.baseline_fit_percent) << ",\n";
@@ -138,6 +147,17 @@ void write_json(const Diagnosis& d, std::ostream& out) {
     out << "}";
   }
   out << (d.calibration.empty() ? "],\n" : "\n  ],\n");
+  out << "  \"loop_timing\": [";
+  bool first_timing = true;
+  for (const auto& c : d.calibration) {
+    if (!c.timing) continue;
+    out << (first_timing ? "\n" : ",\n") << "    {\"name\": " << json_string(c.name) << ", \"unit\": " << json_string(c.unit)
+        << ", \"value\": " << (c.determined ? json_number(c.value) : std::string("null"))
+        << ", \"sigma\": " << (c.determined ? json_number(c.sigma) : std::string("null")) << ", \"bounds\": ["
+        << json_number(c.lo) << ", " << json_number(c.hi) << "]}";
+    first_timing = false;
+  }
+  out << (first_timing ? "],\n" : "\n  ],\n");
   out << "  \"baseline_parameters\": " << json_values(d.baseline_parameters);
   out << ",\n  \"final_parameters\": " << json_values(d.final_parameters);
   out << ",\n  \"undetermined_parameters\": " << json_names_where(d.final_parameters, false);

@@ -10,6 +10,7 @@
 
 #include "tools/diagnosis/engine.hpp"
 #include "tools/diagnosis/model.hpp"
+#include "tools/diagnosis/parallel.hpp"
 #include "tools/hidden_effects/make_run.hpp"
 #include "tools/runfile/run_file.hpp"
 
@@ -87,7 +88,12 @@ SweepResult run_sweep(const SweepOptions& o, const std::atomic<bool>& stop, std:
         if (!file_rig) throw std::runtime_error("the diagnosis has no model of the " + o.rig + " rig");
         const auto rf = read_run_file(mr.out_csv, run_file_columns(*file_rig));
         const auto model = diag::make_rig_model(*file_rig, rf, {});
-        const auto d = diag::diagnose(*model, {});
+        // The runs diagnosed at a time share the machine's threads: each
+        // diagnosis gets its share, so the sweep never runs more threads
+        // than the cores a diagnosis is sized for.
+        diag::DiagnoseOptions dopt;
+        dopt.threads = std::max(1, static_cast<int>(diag::kDefaultDiagnosisThreads) / std::max(1, o.threads));
+        const auto d = diag::diagnose(*model, dopt);
         cell.diagnose_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - d_start).count();
         cell.named = d.cause;
         if (!d.causes.empty()) cell.gain = d.causes.front().gain_percent_points;

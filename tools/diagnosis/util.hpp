@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "tools/diagnosis/model.hpp"
@@ -76,6 +77,29 @@ inline ParamSpec Prior(const std::string& name, const std::string& unit, double 
 inline ParamSpec StandsFor(ParamSpec p, const std::string& cause, int toward) {
   p.stands_for = cause;
   p.toward = toward;
+  return p;
+}
+
+// An effect's parameter that acts on one sensor channel (ParamSpec::channel).
+inline ParamSpec OnChannel(ParamSpec p, const std::string& channel) {
+  p.channel = channel;
+  return p;
+}
+
+// The effect's form index (ParamSpec::form), starting at form 0; `screened`:
+// further forms the screening starts from as well (a form the first cannot
+// stand in for, as a start grid does for a non-convex scalar).
+inline ParamSpec FormIndex(std::vector<double> screened = {}) {
+  ParamSpec p = P("form", "1", 0.0, 0.0, 1e3, 1.0, 0.0, false, std::move(screened));
+  p.form = true;
+  return p;
+}
+
+// A baseline parameter of the loop's I/O timing [s] within [0, hi]
+// (ParamSpec::timing), starting at `init`.
+inline ParamSpec Timing(const std::string& name, double init, double hi, double scale) {
+  ParamSpec p = P(name, "s", init, 0.0, hi, scale);
+  p.timing = true;
   return p;
 }
 

@@ -165,7 +165,7 @@ std::vector<std::vector<std::vector<double>>> responses(const Workspace& w, cons
                                                         const std::vector<Column>& lib) {
   std::vector<std::vector<std::vector<double>>> out(lib.size());
   const bool additive = place.output >= 0 && !place.in_loop;
-  parallel_for(lib.size(), [&](std::size_t k, std::size_t) {
+  parallel_for(w.threads, lib.size(), [&](std::size_t k, std::size_t) {
     auto& resp = out[k];
     if (additive) {  // an error on an output after the replay: its response is the column itself
       resp.assign(w.outs().size(), std::vector<double>(w.n, 0.0));

@@ -26,7 +26,11 @@ void hold_within_cause_band(ParamSpec& sp) {
 }  // namespace
 
 Workspace::Workspace(const RigModel& m, const DiagnoseOptions& o)
-    : model(m), options(o), effects(m.effects()), t0_(std::chrono::steady_clock::now()) {
+    : model(m),
+      options(o),
+      effects(m.effects()),
+      threads(static_cast<std::size_t>(std::max(1, o.threads))),
+      t0_(std::chrono::steady_clock::now()) {
   specs = model.baseline();
   n_base = specs.size();
   // Trending (calibration only): a parameter that stands for a cause is the
@@ -87,6 +91,7 @@ Scored Workspace::fit(const std::vector<double>& start, const std::vector<bool>&
   p.weight = weight;
   p.max_iterations = iterations;
   p.prior_weight = prior_weight;
+  p.threads = &threads;
   const auto r = fit_output_error(p, covariance);
   Scored s = score(r.theta);
   s.sigma = r.sigma;
@@ -99,13 +104,15 @@ std::vector<bool> Workspace::free_for(const std::vector<std::size_t>& active) co
   std::vector<bool> f(specs.size(), false);
   for (std::size_t i = 0; i < n_base; ++i) f[i] = true;
   for (auto e : active)
-    for (std::size_t j = 0; j < effects[e].params.size(); ++j) f[offset[e] + j] = true;
+    for (std::size_t j = 0; j < effects[e].params.size(); ++j) f[offset[e] + j] = !effects[e].params[j].form;
   return f;
 }
 
+// A form index is chosen, not fitted: it does not count.
 std::size_t Workspace::parameter_count(const std::vector<std::size_t>& active) const {
   std::size_t k = n_base;
-  for (auto e : active) k += effects[e].params.size();
+  for (auto e : active)
+    for (const auto& p : effects[e].params) k += p.form ? 0 : 1;
   return k;
 }
 

@@ -11,6 +11,7 @@
 
 #include "tools/diagnosis/engine.hpp"
 #include "tools/diagnosis/model.hpp"
+#include "tools/diagnosis/parallel.hpp"
 
 namespace rigctl::diag {
 
@@ -40,6 +41,7 @@ class Workspace {
   std::vector<double> noise;         // per output: the record's noise floor (evidence.hpp noise_floor)
   std::size_t n_est_values = 0;      // estimation samples x outputs
   double prior_weight = 0.0;         // FitProblem::prior_weight
+  mutable ThreadBudget threads;      // options.threads, shared by every parallel loop of the diagnosis
 
   const std::vector<Output>& outs() const { return model.outputs(); }
   std::vector<double> theta_null() const;  // baseline nominal, every effect at its null

@@ -27,8 +27,8 @@
 //                     tyre is sharp)
 //   damper_asymmetry  F_d = c_i (1 + a tanh(v / 0.01 m/s)) v: rebound c(1 + a),
 //                     compression c(1 - a) (the plant switches sharply)
-//   sensor_delay      the four outputs read tau late (linear interpolation;
-//                     the simulated driver interpolates cubically)
+//   sensor_delay      each output through a sensor of its own group delay, in
+//                     the form that fits best (sensor_filter.hpp)
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -37,6 +37,7 @@
 #include "config/rig_config.hpp"
 #include "plant/half_car/half_car_params.hpp"
 #include "tools/diagnosis/rigs.hpp"
+#include "tools/diagnosis/sensor_filter.hpp"
 #include "tools/diagnosis/util.hpp"
 
 namespace rigctl::diag {
@@ -144,8 +145,14 @@ class HalfCarDiagModel : public RigModel {
         {"damper_asymmetry", {P("asym", "1", 0.0, -0.95, 0.95, 0.1, 0.0, true)},
          "rebound and compression damping differ: c (1 + asym tanh(v_rel / 0.01 m/s)), i.e. "
          "c_reb / c_comp = (1 + asym) / (1 - asym)"},
-        {"sensor_delay", {P("tau", "s", 0.002, 0.0, 0.05, 0.002, 0.0, true, {0.008})},
-         "z_s, phi, z_u1, z_u2 measured late by tau"},
+        {"sensor_delay",
+         {OnChannel(P("tau_z_s", "s", 0.002, 0.0, 0.05, 0.002, 0.0, true, {0.008}), "z_s"),
+          OnChannel(P("tau_phi", "s", 0.002, 0.0, 0.05, 0.002, 0.0, true), "phi"),
+          OnChannel(P("tau_z_u1", "s", 0.002, 0.0, 0.05, 0.002, 0.0, true, {0.008}), "z_u1"),
+          OnChannel(P("tau_z_u2", "s", 0.002, 0.0, 0.05, 0.002, 0.0, true), "z_u2"), FormIndex()},
+         "z_s, phi, z_u1, z_u2 each measured through a sensor of its own group delay tau, in the form that fits "
+         "best: a pure delay, a first-order lag or a Bessel or Butterworth filter of order 2-4",
+         sensor_form_names()},
     };
   }
   std::string replay() const override {
@@ -231,7 +238,7 @@ class HalfCarDiagModel : public RigModel {
     const double ms = th[6], inertia = th[7];
     const double mu[2] = {th[8], th[9]};
     const double lever[2] = {th[10], -th[11]};
-    const double tau_a = th[12], uni = th[13], asym = th[14], tau_s = th[15];
+    const double tau_a = th[12], uni = th[13], asym = th[14];
     const std::size_t n = t_.size();
     y.assign(4, std::vector<double>(n, 0.0));
     const double ct[2] = {p_.tyre_damping_1, p_.tyre_damping_2};
@@ -307,7 +314,8 @@ class HalfCarDiagModel : public RigModel {
         return;
       }
     }
-    for (auto& yc : y) delay(yc, tau_s, dt_);
+    // The four sensors (sensor_delay): th[15..18] their group delays, th[19] the form.
+    for (std::size_t c4 = 0; c4 < 4; ++c4) SensorFilter(sensor_form_at(th[19]), th[15 + c4], dt_).apply(y[c4]);
   }
 
 

@@ -25,9 +25,13 @@
 // with a sine inside, and the averaged characteristic is smooth in every
 // parameter even though the valve's dead band is sharp: what the fit needs.
 // The ripple term assumes the dither is phase-locked to the run's time base
-// (sin(2 pi f t), t from the run file), which the simulator's and a
-// DAC-generated dither are; `# dither_phase_rad: ...` in the run file's
-// metadata sets another phase.
+// (sin(2 pi f t + phase), t from the run file), which the simulator's and a
+// DAC-generated dither are. The phase is the rig's timing: `# dither_phase_rad:
+// ...` in the run file's metadata states it, else it is read off the
+// record's own 50 Hz dp ripple (a rig whose dither starts at another phase,
+// or is generated at the loop's rate and held, has its ripple elsewhere: a
+// ripple modelled 110 degrees off cost a clean run 15 pp of dp's fit, which a
+// filter on dp then "explained" as a sensor delay).
 //
 // Candidate effects (docs/diagnosis.md 2.2), each null gives the baseline:
 //  * bladder_hysteresis: the seed's trapezoid as a smooth two-part element, a
@@ -36,22 +40,36 @@
 //    jumps by 2 h_s, then follows the travel over a few theta_r and
 //    saturates. Rate independent like the bladder; not the plant's linear
 //    ramp with a stick/slip state (plant/bladder_hysteresis.*).
-//  * coulomb_friction: T_c tanh(omega / eps): a full jump at the reversal,
-//    flat in travel (the plant's brake is exact stick/slip).
-//  * polytropic_exponent: heat exchange with the chamber walls. n scales the
-//    chamber pressure rate; slow motion leaves the gas time to exchange heat
-//    (towards isothermal, 1), fast motion does not (adiabatic, 1.4):
-//    n(omega) = n + (1.4 - n) x / sqrt(1 + x^2), x = k_h |omega|, the
-//    magnitude of a first-order thermal lag's high-pass with the rotor
-//    speed standing for the compression's rate (null n = 1.4). k_h = 0 is
-//    a constant exponent, a change of n / V, which the calibrated chamber
-//    volume V also makes: only V's prior tells the two apart; the speed
-//    dependence is a signature V has not.
+//  * coulomb_friction: (T_c + dT_s exp(-(omega / 0.01 rad/s)^2)) tanh(omega /
+//    eps): a full jump at the reversal, flat in travel, with a stiction
+//    excess to break away from rest (the plant's brake is exact stick/slip).
+//  * polytropic_exponent, in two forms: the chamber gas exchanging heat with
+//    the walls through hA (Newton's law, null 0; the gas's exponent n stays
+//    1.4), a temperature state per chamber (their difference; the sum stays
+//    at rest as the pressure sum does), or compressed with a constant
+//    exponent n (null 1.4, no thermal state). With the net mass flow dm
+//    into chamber a and out of b and the volume rate 2 alpha omega:
+//      d(dp)/dt = n (R T / V dm - 2 Pq alpha / V omega) - (1.4 - 1) hA vth / V
+//      d(vth)/dt = T (d(dp)/dt / Pq + 2 alpha omega / V - R T dm / (Pq V))
+//    so slow motion leaves the gas time to reach the walls' temperature
+//    (isothermal), fast motion does not (adiabatic). A constant n below 1.4
+//    is a change of n / V, which the calibrated chamber volume also makes:
+//    only V's prior tells the two apart; hA's dependence on the motion's
+//    rate is a signature V has not.
 //  * valve_null_offset: u0 added to the command before the valve.
 //  * valve_deadband: overlap delta [V] of a sharp dead zone, seen through the
 //    dither average (smooth).
-//  * sensor_delay: theta and dp reach the controller and the record tau late
-//    (linear interpolation; the simulator's delay line is cubic).
+//  * sensor_delay: theta and dp each through a sensor of its own group delay
+//    (tau_theta, tau_dp), inside the loop and in the record, in the form that
+//    fits best (sensor_filter.hpp: pure delay, first-order lag, Bessel or
+//    Butterworth of order 2-4).
+//
+// The loop's I/O timing is calibration, not a cause (docs/diagnosis.md 4):
+// t_command (the command takes effect that long after its sample: a
+// computation delay, up to a period, beside the hold) and t_sample (the
+// sensors are sampled that long before the tick, up to half a period) are
+// baseline parameters fitted within their bounds; only a sensor's delay
+// beyond what they explain is a sensor_delay.
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -62,6 +80,7 @@
 #include "tools/diagnosis/model.hpp"
 #include "tools/diagnosis/models/controller_from_record.hpp"
 #include "tools/diagnosis/rigs.hpp"
+#include "tools/diagnosis/sensor_filter.hpp"
 #include "tools/diagnosis/util.hpp"
 
 namespace rigctl::diag {
@@ -82,6 +101,23 @@ constexpr double kEps = 2e-3;
 // amplitude instead [V] (a few 12-bit DAC steps; a softplus-like rounding).
 constexpr double kMinSmoothingV = 0.05;
 constexpr int kSubsteps = 2;  // 1.25 ms, second-order split below: halving it changes the clean fit by < 0.02 pp
+// Breakaway of the Coulomb friction's stiction excess: it is felt only while
+// the rotor is nearly stuck (a brake's stiction), well below the rig's
+// 0.05-1 rad/s motions and above kEps, so the semi-implicit update can hold it.
+constexpr double kStribeckSpeed = 0.01;  // [rad/s]
+
+// Parameter indices (baseline, then effects in effects() order).
+enum : std::size_t {
+  kI, kB, kC1, kC2, kV, kPq, kAlpha, kDither,  // baseline: the rig's uncertain values
+  kTCmd, kTSample,                             // baseline: the loop's I/O timing
+  kHs, kTe, kThetaR,                           // bladder_hysteresis
+  kTc, kDTs,                                   // coulomb_friction
+  kN, kHA, kGasForm,                           // polytropic_exponent
+  kU0,                                         // valve_null_offset
+  kDelta,                                      // valve_deadband
+  kTauTheta, kTauDp, kSensorFormIndex,         // sensor_delay
+  kParamCount
+};
 
 // Mean and 50 Hz fundamental (coefficient of sin phi) of max(w + A sin phi, 0)
 // over a uniform phase, for A > 0. With c = clamp(-w/A), a = asin(c):
@@ -131,8 +167,14 @@ class PneumaticRotaryModel : public RigModel {
     theta_d_ = run.col("theta_d");
     outputs_ = {{"theta", run.col("theta")}, {"dp", run.col("dp")}};
     u_meas_ = run.col("u");
-    dither_phase_ = run.meta_number("dither_phase_rad").value_or(0.0);
     const double W = 2.0 * kPi * p_.dither_frequency;
+    // The dither's phase against the run's time base is the rig's timing,
+    // not a cause: from the metadata where the run states it, else read off
+    // the record's own dp ripple (dither_phase_from_ripple).
+    const auto stated = run.meta_number("dither_phase_rad");
+    dither_phase_ = stated ? *stated : dither_phase_from_ripple(W);
+    dither_phase_read_ = !stated;
+    dither_phase_source_ = stated ? "stated in the run file" : "read off the record's dp ripple";
     for (double t : t_) {
       sin_.push_back(std::sin(W * t + dither_phase_));
       cos_.push_back(std::cos(W * t + dither_phase_));
@@ -170,7 +212,18 @@ class PneumaticRotaryModel : public RigModel {
             Prior("V", "m^3", p.chamber_volume, 0.05),
             Prior("Pq", "Pa", p.quiescent_pressure, 0.05),
             Prior("alpha", "m^3/rad", p.first_moment, 0.05),
-            Prior("dither", "V", std::max(p.dither_amplitude, 1e-3), 0.05)};
+            Prior("dither", "V", std::max(p.dither_amplitude, 1e-3), 0.05),
+            // The loop's I/O timing (docs/diagnosis.md 4): when the command
+            // takes effect after its sample (a computation delay, up to a
+            // period), and how long before the tick the sensors are sampled
+            // (up to half a period). With the output's hold (half a period
+            // on average, in the replay) the loop's delay can grow by up to
+            // two periods. A rig's own, not a cause: calibrated within these
+            // bounds from rigctl's own convention (sampled at the tick,
+            // applied at once). Wider (two periods and one) they took 7.5 ms
+            // of a 10 ms sensor delay, leaving it 0.5 pp.
+            Timing("t_command", 0.0, dt_, 0.5 * dt_),
+            Timing("t_sample", 0.0, 0.5 * dt_, 0.5 * dt_)};
   }
   std::vector<EffectSpec> effects() const override {
     return {
@@ -181,18 +234,28 @@ class PneumaticRotaryModel : public RigModel {
          "reversal plus a rate-independent Dahl element T_e z, dz/dtheta = (1 - sign(omega) z)/theta_r, that "
          "follows the travel since the reversal over a few theta_r and then saturates; half-width H = h_s + T_e"},
         {"coulomb_friction",
-         {P("T_c", "N m", 0.5, 0.0, 30.0, 1.0, 0.0, true)},
-         "Coulomb friction T_c tanh(omega/eps) on the rotor: full jump at each reversal, flat in travel"},
+         {P("T_c", "N m", 0.5, 0.0, 30.0, 1.0, 0.0, true), P("dT_s", "N m", 0.0, 0.0, 30.0, 1.0, 0.0, true)},
+         "Coulomb friction on the rotor, (T_c + dT_s exp(-(omega/0.01 rad/s)^2)) tanh(omega/eps): a full jump at "
+         "each reversal, flat in travel, with a stiction excess dT_s to break away from rest"},
         {"polytropic_exponent",
-         // k_h: 1 / the rotor speed at which the compression is half-way
-         // too fast for heat exchange; 0 (a constant n, the boundary a
-         // constant-exponent gas reaches) to 50 s/rad (adiabatic above
-         // 0.02 rad/s: at any motion of the rig).
+         // hA: the heat-transfer coefficient of the chamber walls. The gas
+         // of a chamber (m c_v = Pq V / ((1.4 - 1) T), about 1 J/K) follows
+         // its walls in m c_v / hA: 10 ms at 100 W/K (near isothermal at
+         // any motion of the rig), 1 s at 1 W/K.
+         // Two forms that do not nest: with heat exchange the gas's own
+         // exponent stays 1.4 and hA sets how far from adiabatic it gets (a
+         // large hA is isothermal whatever n, so n and hA free together
+         // traded against each other: n 1.11 for a world of constant 1.0);
+         // a constant exponent n has no thermal state. Each form's other
+         // parameter is unused (undetermined). Both forms are screened: an
+         // isothermal gas of constant exponent was not among the best three
+         // when screened as heat exchange alone.
          {P("n", "1", 1.3, 0.8, 1.8, 0.2, 1.4, true, {1.05}),
-          P("k_h", "s/rad", 2.0, 0.0, 50.0, 2.0, 2.0, false, {0.0, 10.0})},
-         "polytropic exponent of the chamber gas, n at rest rising towards 1.4 (adiabatic) with the rotor's "
-         "speed: n(omega) = n + (1.4 - n) x / sqrt(1 + x^2), x = k_h |omega| (pressure rate and pneumatic "
-         "stiffness scale with it; 1 isothermal): heat exchange with the walls"},
+          P("hA", "W/K", 2.0, 0.0, 100.0, 5.0, 0.0, true, {20.0}), FormIndex({1.0})},
+         "the chamber gas: exchanging heat with the walls through hA (Newton's law; a temperature state per "
+         "chamber), so the pressure rate and the pneumatic stiffness fall from adiabatic toward isothermal as the "
+         "motion slows; or compressed with a constant exponent n (1.4 adiabatic, 1 isothermal)",
+         {"heat_exchange", "constant_exponent"}},
         {"valve_null_offset",
          {P("u0", "V", 0.05, -2.0, 2.0, 0.1, 0.0, true, {-0.1})},
          "valve null offset u0 added to the command before the spool (drift of the neutral)"},
@@ -200,16 +263,21 @@ class PneumaticRotaryModel : public RigModel {
          {P("delta", "V", 0.2, 0.0, 3.0, 0.2, 0.0, true, {0.8})},
          "spool overlap: a dead zone of half-width delta [V of command] about null, seen through the dither"},
         {"sensor_delay",
-         {P("tau", "s", 0.002, 0.0, 0.05, 0.005, 0.0, true, {0.007, 0.014})},
-         "theta and dp transducers late by tau (inside the loop and in the record)"},
+         {OnChannel(P("tau_theta", "s", 0.002, 0.0, 0.1, 0.005, 0.0, true, {0.01, 0.03}), "theta"),
+          OnChannel(P("tau_dp", "s", 0.002, 0.0, 0.1, 0.005, 0.0, true, {0.03}), "dp"), FormIndex()},
+         "the theta and dp transducers each late by their group delay tau (inside the loop and in the record), in "
+         "the form that fits best: a pure delay, a first-order lag or a Bessel or Butterworth filter of order 2-4",
+         sensor_form_names()},
     };
   }
+  std::map<std::string, double> constants() const override { return {{"dither_phase_rad", dither_phase_}}; }
   std::string replay() const override {
     return "closed-loop replay: theta_d through the rig's P+V+dP controller (rt/pvp_controller; " + source_ +
            ") and the reduced pneumatic plant (valve, differential chamber pressure, rotor), controller at the run's "
            "period with the command held, " + std::to_string(kSubsteps) +
            " semi-implicit sub-steps per period; the valve dither is kept, averaged over its phase (mean flow and "
-           "50 Hz pressure ripple in closed form)";
+           "50 Hz pressure ripple in closed form, dither phase " + std::to_string(dither_phase_) + " rad " +
+           dither_phase_source_ + ")";
   }
 
   void simulate(const std::vector<double>& th, std::vector<std::vector<double>>& y) const override {
@@ -256,46 +324,97 @@ class PneumaticRotaryModel : public RigModel {
     std::vector<std::vector<double>> y;
     std::vector<double> torque;
     run(th, y, &torque, cause == "coulomb_friction" ? 2 : 1);
-    for (auto& v : torque) v /= th[6];
+    for (auto& v : torque) v /= th[kAlpha];
     return torque;
   }
 
  private:
+  // The chambers' differential pressure dp and the gas temperature
+  // difference vth between them (the thermal state of polytropic_exponent;
+  // both sums stay at their start, as the pressure sum does, docs above).
+  struct Gas {
+    double gas0, mot0, C2, n, hA, V, Pq, T, R;  // R T / V, Pq alpha / V, ...
+    // Half a sub-step of the chambers at flow 2 C1 x_o and rotor speed w.
+    void advance(double& dp, double& vth, double flow, double w, double h, double alpha) const {
+      const double dm = flow - C2 * dp;  // net mass flow into a, out of b [kg/s]
+      const double rate = n * (gas0 * dm - 2.0 * mot0 * w) - (kAdiabaticExponent - 1.0) * hA * vth / V;
+      if (hA > 0.0) vth += h * T * (rate / Pq + 2.0 * alpha * w / V - R * T * dm / (Pq * V));
+      dp += h * rate;
+    }
+  };
+
+  // The valve's opening for each command computed so far, and which of them
+  // acts over a part of a period when the command takes effect t_command
+  // after its sample: over [t_k, t_k + f dt) the command of tick k - m - 1,
+  // then that of tick k - m (t_command = (m + f) dt). Before the first, the
+  // valve at null.
+  struct CommandQueue {
+    std::vector<HalfWave> opening;
+    HalfWave rest;
+    std::size_t m = 0;
+    double f = 0.0;
+    const HalfWave& at(std::size_t k, std::size_t back) const { return k >= back ? opening[k - back] : rest; }
+    // Mean of the opening over [t_k + a dt, t_k + b dt), 0 <= a < b <= 1.
+    HalfWave mean(std::size_t k, double a, double b) const {
+      const double old_share = std::clamp((f - a) / (b - a), 0.0, 1.0);
+      const HalfWave& o = at(k, m + 1);
+      const HalfWave& c = at(k, m);
+      return {old_share * o.mean + (1.0 - old_share) * c.mean,
+              old_share * o.fundamental + (1.0 - old_share) * c.fundamental};
+    }
+  };
+
   // which: 1 hysteresis torque, 2 Coulomb torque, into *torque per sample.
   // d: the where's signal at places()[place], per sample (null: none).
   void run(const std::vector<double>& th, std::vector<std::vector<double>>& y, std::vector<double>* torque,
            int which = 0, std::size_t place = 0, const std::vector<double>* d = nullptr) const {
     auto added = [&](std::size_t p, std::size_t k) { return d && place == p ? (*d)[k] : 0.0; };
-    const double I = th[0], b = th[1], C1 = th[2], C2 = th[3], V = th[4], Pq = th[5], alpha = th[6], dither = th[7];
-    const double hs = th[8], te = th[9], thr = std::max(th[10], 1e-4), tc = th[11], n_rest = th[12],
-                 k_h = th[13], u0 = th[14], delta = th[15], tau = th[16];
+    const double I = th[kI], b = th[kB], C1 = th[kC1], V = th[kV], alpha = th[kAlpha], dither = th[kDither];
+    const double hs = th[kHs], te = th[kTe], thr = std::max(th[kThetaR], 1e-4), tc = th[kTc], dts = th[kDTs],
+                 u0 = th[kU0], delta = th[kDelta];
     const std::size_t N = t_.size();
     y.assign(2, std::vector<double>(N, 0.0));
     if (torque) torque->assign(N, 0.0);
     const auto& p = p_;
-    const double gas0 = p.gas_constant * p.supply_temperature / V;  // R T / V; times n
-    const double mot0 = Pq * alpha / V;                             // Pq alpha / V; times n
-    const bool speed_dependent_n = n_rest != kAdiabaticExponent;
-    auto exponent = [&](double omega) {
-      if (!speed_dependent_n) return kAdiabaticExponent;
-      const double x = k_h * omega;
-      return n_rest + (kAdiabaticExponent - n_rest) * std::abs(x) / std::sqrt(1.0 + x * x);
-    };
+    const Gas gas{p.gas_constant * p.supply_temperature / V,
+                  th[kPq] * alpha / V,
+                  th[kC2],
+                  th[kGasForm] > 0.5 ? th[kN] : kAdiabaticExponent,  // constant_exponent : heat_exchange
+                  th[kGasForm] > 0.5 ? 0.0 : th[kHA],
+                  V,
+                  th[kPq],
+                  p.supply_temperature,
+                  p.gas_constant};
     const double Lv = p.spool_limit / p.solenoid_gain;
     const double A = p.dither ? dither : 0.0;
     const double A_avg = std::max(A, kMinSmoothingV);
     const double W = 2.0 * kPi * p.dither_frequency;
-    // dp ripple of a fundamental F [V] of the opening: 2 n R T/V C1 k F (a sin - W cos) / (W^2 + a^2),
-    // a = n R T / V C2 (1 / tau_chamber), with n at the rotor's speed.
-    // At t_k - tau: the dither phase of t_k turned back by W tau.
-    const double cd = std::cos(W * tau), sd = std::sin(W * tau);
-    auto ripple = [&](std::size_t k, double fundamental, double n) {
-      if (!(A > 0.0)) return 0.0;
-      const double gas = n * gas0, leak = gas * C2;
-      const double sn = sin_[k] * cd - cos_[k] * sd, cs = cos_[k] * cd + sin_[k] * sd;
-      return 2.0 * gas * C1 * p.solenoid_gain / (W * W + leak * leak) * fundamental * (leak * sn - W * cs);
-    };
     auto opening = [&](double u) { return dithered_opening(u + u0, A_avg, std::min(delta, 0.99 * Lv), Lv); };
+
+    // The sensors: sampled t_sample before the tick, each through its own
+    // conditioning (sensor_delay). The 50 Hz ripple on dp passes the dp
+    // sensor as a sine does (its gain and phase at 50 Hz).
+    const double sample_back = th[kTSample] / dt_;
+    const SensorForm form = sensor_form_at(th[kSensorFormIndex]);
+    SensorFilter sense_theta(form, th[kTauTheta], dt_), sense_dp(form, th[kTauDp], dt_);
+    // The ripple's phase in the record is the sum of the dither's, the
+    // sampling's and the dp sensor's: a phase read off the record holds all
+    // three, so then the sensor and the sampling add no turn of their own
+    // (they would count twice: a 10 ms delay turned the ripple by another
+    // half period and gained 0.5 pp); only a stated dither phase leaves
+    // theirs to the model. The sensor's gain at 50 Hz applies either way.
+    const auto dp_response = sense_dp.response(W);
+    const double ripple_gain = std::abs(dp_response);
+    const double ripple_turn = dither_phase_read_ ? 0.0 : std::arg(dp_response) - W * th[kTSample];
+    const double cr = std::cos(ripple_turn), sr = std::sin(ripple_turn);
+    // dp ripple of a fundamental F [V] of the opening: 2 n R T/V C1 k F (a sin - W cos) / (W^2 + a^2),
+    // a = n R T / V C2 (1 / tau_chamber), its phase turned by the sampling and the sensor.
+    auto ripple = [&](std::size_t k, double fundamental) {
+      if (!(A > 0.0)) return 0.0;
+      const double g = gas.n * gas.gas0, leak = g * gas.C2;
+      const double sn = sin_[k] * cr + cos_[k] * sr, cs = cos_[k] * cr - sin_[k] * sr;
+      return ripple_gain * 2.0 * g * C1 * p.solenoid_gain / (W * W + leak * leak) * fundamental * (leak * sn - W * cs);
+    };
 
     PvpController ctrl(pvp_);
     ctrl.reset();
@@ -303,41 +422,49 @@ class PneumaticRotaryModel : public RigModel {
     Command cmd{};
     ControllerTerms terms{};
 
+    CommandQueue queue;
+    queue.rest = opening(0.0);
+    queue.opening.reserve(N);
+    const double cmd_periods = th[kTCmd] / dt_;
+    queue.m = static_cast<std::size_t>(std::max(0.0, std::floor(cmd_periods)));
+    queue.f = cmd_periods - static_cast<double>(queue.m);
     std::vector<double> h_theta(N), h_dp(N), h_fund(N);
-    double fund_prev = opening(0.0).fundamental;
+    double fund_prev = queue.rest.fundamental;
     // Slow part of dp at the start: the measured mean over one dither period
     // less the modelled ripple's mean there.
     double rip0 = 0.0;
-    for (std::size_t i = 0; i < dp0_window_; ++i) rip0 += ripple(i, fund_prev, n_rest) / static_cast<double>(dp0_window_);
-    double theta = theta0_, omega = 0.0, dp = dp0_ - rip0, z = 0.0;
+    for (std::size_t i = 0; i < dp0_window_; ++i) rip0 += ripple(i, fund_prev) / static_cast<double>(dp0_window_);
+    double theta = theta0_, omega = 0.0, dp = dp0_ - rip0, vth = 0.0, z = 0.0;
+    sense_theta.reset(theta);
+    sense_dp.reset(dp);
     const double h = dt_ / kSubsteps;
-    const double S = hs + tc;  // level of the sign-like torques
-    const double shift = tau / dt_;
-    const bool sign_like = S > 0.0, dahl = te > 0.0;
+    const bool sign_like = hs + tc + dts > 0.0, dahl = te > 0.0;
     for (std::size_t k = 0; k < N; ++k) {
       h_theta[k] = theta;
       h_dp[k] = dp;
       h_fund[k] = fund_prev;  // the ripple at t_k comes from the opening over the period before it
-      const double s = std::min(static_cast<double>(k), static_cast<double>(k) - shift);
-      const double theta_m = at(h_theta, s) + added(3, k);
-      const double dp_m = at(h_dp, s) + ripple(k, at(h_fund, s), exponent(omega)) + added(4, k);
+      const double s = static_cast<double>(k) - sample_back;
+      const double theta_m = sense_theta.step(at(h_theta, s)) + added(3, k);
+      const double dp_m = sense_dp.step(at(h_dp, s)) + ripple(k, at(h_fund, s - th[kTauDp] / dt_)) + added(4, k);
       y[0][k] = theta_m;
       y[1][k] = dp_m;
       sample.value[0] = theta_m;
       sample.value[1] = dp_m;
       ctrl.update(theta_d_[k], sample, cmd, terms);
-      const auto op = opening(cmd.value[0] + added(2, k));
+      queue.opening.push_back(opening(cmd.value[0] + added(2, k)));
+      fund_prev = A > 0.0 ? queue.mean(k, 0.0, 1.0).fundamental : 0.0;
       const double torque_in = added(0, k), rate_in = added(1, k);
-      fund_prev = A > 0.0 ? op.fundamental : 0.0;
-      const double flow = 2.0 * C1 * p.solenoid_gain * op.mean;  // 2 C1 x_o [kg/s]
       // Each sub-step is split symmetrically (Strang): half a step of the
       // chambers, the rotor over the whole step, the other half of the
       // chambers with the new speed; the angle and the Dahl travel use the
       // mean speed. Second order, so the sub-step leaves no O(h) time shift
       // between angle and pressure that would pass for a sensor delay.
       for (int j = 0; j < kSubsteps; ++j) {
-        const double n = exponent(omega);  // over the sub-step, at its start's speed
-        dp += 0.5 * h * (n * (gas0 * flow - gas0 * C2 * dp - 2.0 * mot0 * omega) + rate_in);
+        const double a = static_cast<double>(j) / kSubsteps, e = static_cast<double>(j + 1) / kSubsteps;
+        const double flow = 2.0 * C1 * p.solenoid_gain * queue.mean(k, a, e).mean;  // 2 C1 x_o [kg/s]
+        gas.advance(dp, vth, flow, omega, 0.5 * h, alpha);
+        dp += 0.5 * h * rate_in;
+        const double S = hs + tc + dts * std::exp(-(omega / kStribeckSpeed) * (omega / kStribeckSpeed));
         const double th_ = sign_like ? std::tanh(omega / kEps) : 0.0;
         const double T = alpha * dp - te * z + stop_torque(theta + 0.5 * h * omega, omega) + torque_in;
         // Semi-implicit in omega for the stiff tanh and the viscous term.
@@ -346,19 +473,21 @@ class PneumaticRotaryModel : public RigModel {
         const double wm = 0.5 * (omega + wn);
         theta += h * wm;
         if (dahl) {  // exact for the mean speed over the sub-step
-          const double a = wm * std::tanh(wm / kEps) / thr * h;  // >= 0
-          const double e = std::exp(-a);
-          z = z * e + (wm * h / thr) * (a > 1e-12 ? (1.0 - e) / a : 1.0 - 0.5 * a);
+          const double da = wm * std::tanh(wm / kEps) / thr * h;  // >= 0
+          const double ex = std::exp(-da);
+          z = z * ex + (wm * h / thr) * (da > 1e-12 ? (1.0 - ex) / da : 1.0 - 0.5 * da);
         }
-        dp += 0.5 * h * (n * (gas0 * flow - gas0 * C2 * dp - 2.0 * mot0 * wn) + rate_in);
+        gas.advance(dp, vth, flow, wn, 0.5 * h, alpha);
+        dp += 0.5 * h * rate_in;
         omega = wn;
       }
       if (torque) {
         const double sg = std::tanh(omega / kEps);
-        (*torque)[k] = which == 2 ? tc * sg : hs * sg + te * z;
+        (*torque)[k] = which == 2 ? (tc + dts * std::exp(-(omega / kStribeckSpeed) * (omega / kStribeckSpeed))) * sg
+                                  : hs * sg + te * z;
       }
       if (!std::isfinite(theta) || !std::isfinite(dp)) {
-        for (std::size_t j = k; j < N; ++j) y[0][j] = 1e3, y[1][j] = 1e9;
+        for (std::size_t jj = k; jj < N; ++jj) y[0][jj] = 1e3, y[1][jj] = 1e9;
         return;
       }
     }
@@ -372,6 +501,34 @@ class PneumaticRotaryModel : public RigModel {
     if (theta < -p.angle_limit)
       return std::max(0.0, -p.end_stop_stiffness * (theta + p.angle_limit) - p.end_stop_damping * omega);
     return 0.0;
+  }
+
+  // The dither phase at which the baseline's ripple (phase = dither phase
+  // - atan2(W, a), a = 1.4 R T / V C2 the chambers' pole, docs above) has
+  // the phase of the 50 Hz component of the measured dp: a lock-in over the
+  // whole record, dp less its mean over one dither period. A record whose
+  // ripple does not stand out of the noise (less than 4 standard errors of
+  // the lock-in) keeps phase 0, the simulator's and a DAC's convention.
+  double dither_phase_from_ripple(double W) const {
+    const auto& dp = outputs_[1].measured;
+    const auto per = static_cast<std::size_t>(std::lround(1.0 / (p_.dither_frequency * dt_)));
+    if (per < 3 || dp.size() < 4 * per) return 0.0;
+    const auto mean = moving_mean(dp, per);
+    double s = 0.0, c = 0.0, ss = 0.0;
+    std::size_t n = 0;
+    for (std::size_t i = per; i < dp.size(); ++i) {
+      const double hp = dp[i] - mean[i];  // the window ends at i: its 50 Hz content is zero, its delay irrelevant
+      s += hp * std::sin(W * t_[i]);
+      c += hp * std::cos(W * t_[i]);
+      ss += hp * hp;
+      ++n;
+    }
+    const double amp = 2.0 * std::hypot(s, c) / static_cast<double>(n);
+    const double se = 2.0 * std::sqrt(ss / static_cast<double>(n)) / std::sqrt(static_cast<double>(n));
+    if (!(amp > 4.0 * se)) return 0.0;
+    const double pole = kAdiabaticExponent * p_.gas_constant * p_.supply_temperature / p_.chamber_volume *
+                        p_.flow_pressure_coefficient;
+    return std::atan2(c, s) + std::atan2(W, pole);
   }
 
   static std::vector<double> moving_mean(const std::vector<double>& x, std::size_t w) {
@@ -419,6 +576,8 @@ class PneumaticRotaryModel : public RigModel {
   PvpConfig pvp_;
   std::string source_;
   double dither_phase_ = 0.0, theta0_ = 0.0, dp0_ = 0.0;
+  std::string dither_phase_source_;
+  bool dither_phase_read_ = false;  // off the record's ripple, sensor and sampling included
   std::size_t dp0_window_ = 1;
   std::vector<Output> outputs_;
 };

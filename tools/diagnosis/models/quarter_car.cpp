@@ -8,12 +8,15 @@
 //    actuator_seal_friction, cross_port_leakage, valve_deadband, entrained_air.
 //  * Suspension (open-loop replay): the measured x_r drives wheel and body.
 //    Outputs x_b, x_w and, where recorded, the tyre load f_t. Causes:
-//    bearing_friction, damper_asymmetry, sensor_delay, sensor_offset,
-//    tyre_liftoff.
+//    bearing_friction, damper_asymmetry, sensor_offset, tyre_liftoff.
 // An effect of one sub-model leaves the other's outputs unchanged, so the
-// engine's per-signal gain points at the right place; the two exceptions are
-// tyre lift-off (the tyre is in both) and an offset on the x_w transducer
-// (the actuator's tyre load is driven by the measured x_w).
+// engine's per-signal gain points at the right place; the exceptions are
+// tyre lift-off (the tyre is in both), an offset on the x_w transducer (the
+// actuator's tyre load is driven by the measured x_w) and the sensors
+// (sensor_delay): x_r's is the controller's feedback, inside the actuator's
+// loop, and both sub-models are driven by a measured position (x_r, x_w),
+// which a late sensor shows late; the replay drives them with the measured
+// input advanced by its sensor's group delay.
 #include <algorithm>
 #include <cmath>
 #include <mutex>
@@ -26,6 +29,7 @@
 #include "rt/control/pi_controller.hpp"
 #include "tools/diagnosis/models/controller_from_record.hpp"
 #include "tools/diagnosis/rigs.hpp"
+#include "tools/diagnosis/sensor_filter.hpp"
 #include "tools/diagnosis/util.hpp"
 
 namespace rigctl::diag {
@@ -41,6 +45,12 @@ std::string fmt_bar(double pa) { return std::to_string(static_cast<long>(std::lr
 // pressure: 0.23 pp on p2, `unexplained` at 7 x its noise.
 constexpr double kBubbleIndex = 1.2;
 
+// Below this pressure difference the orifice leak of cross_port_leakage is
+// taken as laminar (its sqrt has an infinite slope at 0, which the fit's
+// derivatives and the RK4 step cannot take); 1 bar is about 2 % of the rig's
+// load pressures.
+constexpr double kOrificeTransition = 1e5;  // [Pa]
+
 // Smooth max(0, x) with a corner of width eps (softplus): the fitted
 // candidates are smooth where the generating physics is sharp.
 double softplus(double x, double eps) {
@@ -55,9 +65,9 @@ double tyre_contact(double f_total, double uni) {
 }
 
 // The causes of the suspension sub-model alone (tyre lift-off and the
-// sensor offset act in both; the rest are the actuator's).
+// sensors act in both; the rest are the actuator's).
 bool suspension_cause(const std::string& cause) {
-  return cause == "bearing_friction" || cause == "damper_asymmetry" || cause == "sensor_delay";
+  return cause == "bearing_friction" || cause == "damper_asymmetry";
 }
 
 // Parameter indices (baseline, then effects in effects() order).
@@ -66,11 +76,11 @@ enum : std::size_t {
   kKv, kTauR, kBetaNom, kRl, kPs, kA1, kA2, kBvr, kVd,  // baseline: valve and actuator
   kFc, kDFs, kD, kMu,            // bearing_friction
   kDc,                           // damper_asymmetry
-  kTau,                          // sensor_delay
+  kTauXr, kTauXb, kTauXw, kSensorForm,  // sensor_delay
   kBb, kBw,                      // sensor_offset
   kUni,                          // tyre_liftoff
   kSealFm, kSealPc,              // actuator_seal_friction
-  kLeak,                         // cross_port_leakage
+  kLeak, kLeakOrifice,           // cross_port_leakage
   kDead,                         // valve_deadband
   kAirFraction,                  // entrained_air
   kParamCount
@@ -94,9 +104,11 @@ struct Extra {
   double rod = 0.0, spool = 0.0, cross = 0.0, q1 = 0.0, q2 = 0.0;
 };
 
-constexpr std::size_t kSuspensionParams[] = {kKs, kBd, kMb, kMw, kKt, kBt, kFc, kDFs, kD, kMu, kDc, kTau, kBb, kBw, kUni};
-constexpr std::size_t kActuatorParams[] = {kMb,  kMw,  kKt,  kBt,    kKv,    kTauR, kBetaNom, kRl, kPs,  kA1,
-                                           kA2,  kBvr, kVd,  kUni,   kSealFm, kSealPc, kLeak, kDead, kAirFraction, kBw};
+constexpr std::size_t kSuspensionParams[] = {kKs,  kBd,    kMb,    kMw,    kKt,         kBt, kFc, kDFs, kD,  kMu,
+                                             kDc, kTauXr, kTauXb, kTauXw, kSensorForm, kBb, kBw, kUni};
+constexpr std::size_t kActuatorParams[] = {kMb,  kMw,     kKt,     kBt,   kKv,   kTauR,        kBetaNom, kRl,
+                                           kPs,  kA1,     kA2,     kBvr,  kVd,   kUni,         kSealFm,  kSealPc,
+                                           kLeak, kLeakOrifice, kDead, kAirFraction, kBw, kTauXr, kTauXw, kSensorForm};
 
 template <std::size_t N>
 std::vector<double> key(const std::vector<double>& th, const std::size_t (&idx)[N]) {
@@ -206,6 +218,11 @@ class QuarterCarModel : public RigModel {
             Prior("Ps", "Pa", p.supply_pressure, 0.05),          Prior("A1", "m^2", p.area_cap, 0.05),
             Prior("A2", "m^2", p.area_rod, 0.05),                Prior("Bvr", "N s/m", p.rod_damping, 0.10),
             Prior("V_dead", "m^3", p.dead_volume_cap, 0.05)};
+    // No loop-timing parameters here (the pneumatic rig has them): with
+    // t_command and t_sample in the actuator's loop the quarter car's fits
+    // ran to their iteration limits (calibration 5 + 6 iterations became
+    // 22 + 21, a devset diagnosis 26 s of CPU became 134 s), and the
+    // development set's quarter-car clean runs need none.
   }
   std::vector<EffectSpec> effects() const override {
     return {
@@ -218,7 +235,13 @@ class QuarterCarModel : public RigModel {
          "stiction excess dFs with a Stribeck decay (v_s 15 mm/s), viscous D, on the absolute body velocity"},
         {"damper_asymmetry", {P("dc", "N s/m", 0.0, -1e5, 1e5, 100.0, 0.0, true)},
          "rebound and compression damping differ: bd + dc tanh(v_rel / 0.01 m/s)"},
-        {"sensor_delay", {P("tau", "s", 0.002, 0.0, 0.1, 0.002, 0.0, true, {0.01})}, "x_w, x_b measured late by tau"},
+        {"sensor_delay",
+         {OnChannel(P("tau_x_r", "s", 0.002, 0.0, 0.1, 0.002, 0.0, true, {0.01}), "x_r"),
+          OnChannel(P("tau_x_b", "s", 0.002, 0.0, 0.1, 0.002, 0.0, true, {0.01}), "x_b"),
+          OnChannel(P("tau_x_w", "s", 0.002, 0.0, 0.1, 0.002, 0.0, true), "x_w"), FormIndex()},
+         "the x_r (the controller's feedback), x_b and x_w transducers each late by their group delay tau, in the "
+         "form that fits best: a pure delay, a first-order lag or a Bessel or Butterworth filter of order 2-4",
+         sensor_form_names()},
         {"sensor_offset",
          {P("b_b", "m", 0.0, -0.1, 0.1, 1e-3, 0.0, true), P("b_w", "m", 0.0, -0.1, 0.1, 1e-3, 0.0, true)},
          "constant offsets on the x_b and x_w transducers"},
@@ -233,8 +256,11 @@ class QuarterCarModel : public RigModel {
          {P("F_m", "N", 50.0, 0.0, 2000.0, 50.0, 0.0, true), P("f_c", "N/Pa", 0.0, 0.0, 1e-4, 2e-6, 0.0, true)},
          "rod seal friction: Coulomb (F_m + f_c (p1 + p2 - " + fmt_bar(seal_sum_) +
              " bar, the run's mean)) sign(v_r) on the actuator, stick-capable"},
-        {"cross_port_leakage", {P("C_il", "m^3/(s Pa)", 2e-12, 0.0, 1e-9, 4e-12, 0.0, true)},
-         "extra laminar cross-port leakage C_il (p1 - p2) beside the nominal one"},
+        {"cross_port_leakage",
+         {P("C_il", "m^3/(s Pa)", 2e-12, 0.0, 1e-9, 4e-12, 0.0, true),
+          P("C_t", "m^3/(s Pa^0.5)", 0.0, 0.0, 1e-6, 5e-9, 0.0, true)},
+         "extra cross-port leakage beside the nominal one, laminar C_il (p1 - p2) and through an orifice "
+         "(turbulent) C_t sign(p1 - p2) sqrt|p1 - p2|"},
         {"valve_deadband", {P("delta", "1", 0.01, 0.0, 0.3, 0.01, 0.0, true, {0.04})},
          "spool overlap: metering edge x_s - delta (softplus-smoothed dead zone over +-delta)"},
         {"entrained_air", {P("alpha", "1", 0.02, 0.0, 0.5, 0.02, 0.0, true, {0.1})},
@@ -244,20 +270,20 @@ class QuarterCarModel : public RigModel {
   }
   // Suspension causes move only the suspension's parameters (the tyre and
   // masses are in both); actuator causes only the actuator's; lift-off and
-  // the sensor offset both (an offset on x_w is also in the actuator's
+  // the sensors both (an offset on x_w is also in the actuator's
   // wheel input, so the actuator's calibration may have bent to it).
   bool couples(std::size_t index, const std::string& cause) const override {
     const bool suspension_param = index <= kBt;
     const bool shared = index >= kMb && index <= kBt;
     if (suspension_cause(cause)) return suspension_param;
-    if (cause == "tyre_liftoff" || cause == "sensor_offset") return true;
+    if (cause == "tyre_liftoff" || cause == "sensor_offset" || cause == "sensor_delay") return true;
     return !suspension_param || shared;
   }
   std::map<std::string, double> constants() const override {
     return {{"P_m", seal_sum_}, {"air_bubble_index", kBubbleIndex}};
   }
   std::vector<std::size_t> acts_on(const std::string& cause) const override {
-    if (cause == "tyre_liftoff" || cause == "sensor_offset") return {};  // both sub-models
+    if (cause == "tyre_liftoff" || cause == "sensor_offset" || cause == "sensor_delay") return {};  // both sub-models
     const std::size_t ft = 2 + act_outputs_;
     if (suspension_cause(cause)) {
       if (ft_.empty()) return {0, 1};
@@ -416,7 +442,10 @@ class QuarterCarModel : public RigModel {
   void simulate_suspension(const std::vector<double>& th, std::vector<double>& yb, std::vector<double>& yw,
                            std::vector<double>* yf, std::size_t samples, const Injection* in = nullptr) const {
     const double ks = th[kKs], bd = th[kBd], Fc = th[kFc], dFs = th[kDFs], D = th[kD], mu = th[kMu], dc = th[kDc],
-                 tau = th[kTau], b_b = th[kBb], b_w = th[kBw], uni = th[kUni];
+                 b_b = th[kBb], b_w = th[kBw], uni = th[kUni];
+    // The measured x_r drives the wheel: a late x_r sensor shows the road
+    // late, so the replay takes it advanced by the sensor's group delay.
+    const std::vector<double> xr_in = advanced(xr_, th[kTauXr]);
     const std::size_t n = t_.size();
     const int sub = 8;
     const double h = dt_ / sub;
@@ -430,7 +459,7 @@ class QuarterCarModel : public RigModel {
                    f_susp = in ? in->at(kInSuspension, i) : 0.0;
       yb[i] = xb + b_b;
       yw[i] = xw + b_w + (in ? in->at(kSensorXw, i) : 0.0);
-      const double xr0 = xr_[i], xr1 = i + 1 < n ? xr_[i + 1] : xr_[i];
+      const double xr0 = xr_in[i], xr1 = i + 1 < n ? xr_in[i + 1] : xr_in[i];
       const double vr = (xr1 - xr0) / dt_;
       if (yf) (*yf)[i] = tyre_contact(f0 + kt * (xr0 - xw) + bt * (vr_load_[i] - vw), uni);
       for (int s = 0; s < sub; ++s) {
@@ -456,8 +485,20 @@ class QuarterCarModel : public RigModel {
         return;
       }
     }
-    delay(yb, tau, dt_);
-    delay(yw, tau, dt_);
+    const SensorForm form = sensor_form_at(th[kSensorForm]);
+    SensorFilter(form, th[kTauXb], dt_).apply(yb);
+    SensorFilter(form, th[kTauXw], dt_).apply(yw);
+  }
+
+  // x advanced by tau [s] (the value tau later; the last value held): the
+  // true signal under a sensor of that group delay, to its low-frequency
+  // order. Unchanged for tau = 0.
+  std::vector<double> advanced(const std::vector<double>& x, double tau) const {
+    if (!(tau > 0.0)) return x;
+    std::vector<double> out(x.size());
+    const double shift = tau / dt_;
+    for (std::size_t i = 0; i < x.size(); ++i) out[i] = at(x, static_cast<double>(i) + shift);
+    return out;
   }
 
   // State of the actuator replay: spool, chamber pressures, rod.
@@ -474,7 +515,15 @@ class QuarterCarModel : public RigModel {
     const double xs = a.xs + x.spool;
     const double spool = delta > 0.0 ? softplus(xs - delta, 0.002) - softplus(-xs - delta, 0.002) : xs;
     const ValveFlows q = valve_flows(spool, a.p1, a.p2, p.valve_flow_gain * th[kKv], th[kPs], p.laminar_pressure);
-    const double q_leak = (p.leakage ? (a.p1 - a.p2) / th[kRl] : 0.0) + th[kLeak] * (a.p1 - a.p2) + x.cross;
+    const double dpl = a.p1 - a.p2;
+    // A worn seal leaks laminar (C_il dp) and through an orifice (C_t
+    // sign(dp) sqrt(|dp|), turbulent), smoothed to laminar below
+    // kOrificeTransition so its slope stays finite at dp = 0.
+    const double q_orifice =
+        th[kLeakOrifice] != 0.0
+            ? th[kLeakOrifice] * dpl / std::sqrt(std::sqrt(dpl * dpl + kOrificeTransition * kOrificeTransition))
+            : 0.0;
+    const double q_leak = (p.leakage ? dpl / th[kRl] : 0.0) + th[kLeak] * dpl + q_orifice + x.cross;
     // Free air: a bulk modulus that falls with the chamber's pressure
     // (kBubbleIndex: bubbles between isothermal and adiabatic).
     const double alpha = th[kAirFraction], beta_oil = th[kBetaNom];
@@ -495,12 +544,48 @@ class QuarterCarModel : public RigModel {
     d.vr = (a.p1 * a1 - a.p2 * a2 - th[kBvr] * a.vr - f_tyre - p.mass_rod * p.gravity + x.rod) / p.mass_rod;
   }
 
+  // One RK4 sub-step of the actuator over h, then the seal's friction.
+  void rk4_substep(const std::vector<double>& th, Act& a, double u, double xw, double vw, double h, const Extra& x,
+                   bool seal_in) const {
+    auto axpy = [](const Act& s, double k, const Act& d) {
+      return Act{s.xs + k * d.xs, s.p1 + k * d.p1, s.p2 + k * d.p2, s.xr + k * d.xr, s.vr + k * d.vr};
+    };
+    Act k1, k2, k3, k4;
+    actuator_derivatives(th, a, u, xw, vw, k1, x);
+    actuator_derivatives(th, axpy(a, 0.5 * h, k1), u, xw, vw, k2, x);
+    actuator_derivatives(th, axpy(a, 0.5 * h, k2), u, xw, vw, k3, x);
+    actuator_derivatives(th, axpy(a, h, k3), u, xw, vw, k4, x);
+    a.xs += h / 6.0 * (k1.xs + 2 * k2.xs + 2 * k3.xs + k4.xs);
+    a.p1 += h / 6.0 * (k1.p1 + 2 * k2.p1 + 2 * k3.p1 + k4.p1);
+    a.p2 += h / 6.0 * (k1.p2 + 2 * k2.p2 + 2 * k3.p2 + k4.p2);
+    a.xr += h / 6.0 * (k1.xr + 2 * k2.xr + 2 * k3.xr + k4.xr);
+    a.vr += h / 6.0 * (k1.vr + 2 * k2.vr + 2 * k3.vr + k4.vr);
+    a.p1 = std::max(a.p1, p_.cavitation_pressure);
+    a.p2 = std::max(a.p2, p_.cavitation_pressure);
+    // The seal's Coulomb friction, split from the RK4 step and applied
+    // implicitly (Moreau), so the rod can stick: a seal's step is sharp
+    // (1-10 mm/s) against the 5 kg rod, a slope RK4 at 0.5 ms cannot
+    // take smoothly. The earlier tanh(v_r / 0.02 m/s) was what RK4
+    // could: it gained 0.98 pp against the 1 pp floor on the sweep's
+    // strong Stribeck-form seal (1.16 pp now) and 1.58 on the Simscape
+    // form (1.92 now).
+    if (seal_in) {
+      const double level = std::max(0.0, th[kSealFm] + th[kSealPc] * (std::max(0.0, a.p1 + a.p2) - seal_sum_));
+      a.vr = implicit_velocity(p_.mass_rod, a.vr, 0.0, h, level, level, 0.0, 0.0);
+    }
+  }
+
   void simulate_actuator(const std::vector<double>& th, std::vector<std::vector<double>>& y, std::size_t samples,
                          const Injection* in = nullptr) const {
     const std::size_t n = t_.size();
     const bool pressures = act_outputs_ > 2;
     PiController pi(pi_);
     pi.reset();
+    // x_r reaches the controller and the record through its sensor; the
+    // measured x_w drives the tyre advanced by its sensor's group delay.
+    SensorFilter sense_xr(sensor_form_at(th[kSensorForm]), th[kTauXr], dt_);
+    sense_xr.reset(xr_[0]);
+    const std::vector<double> xw_in = advanced(xw_, th[kTauXw]);
     const QuarterCarState rest = QuarterCarPlant::rest_state(p_);
     Act a{rest.x_s, rest.p1, rest.p2, xr_[0], 0.0};
     if (pressures) {  // start from the recorded pressures: the rig's state, not the nominal rest
@@ -519,16 +604,14 @@ class QuarterCarModel : public RigModel {
     Sample s;
     Command c;
     ControllerTerms terms;
-    auto axpy = [](const Act& x, double k, const Act& d) {
-      return Act{x.xs + k * d.xs, x.p1 + k * d.p1, x.p2 + k * d.p2, x.xr + k * d.xr, x.vr + k * d.vr};
-    };
     for (std::size_t i = 0; i < samples; ++i) {
-      const double xr_error = in ? in->at(kSensorXr, i) : 0.0;
-      s.value[0] = a.xr + xr_error;
+      // The controller's feedback, through its sensor (and the where's error on it).
+      const double xr_m = sense_xr.step(a.xr) + (in ? in->at(kSensorXr, i) : 0.0);
+      s.value[0] = xr_m;
       pi.update(xref_[i], s, c, terms);
       const double u = std::clamp(c.value[0], -1.0, 1.0);
       y[2][i] = u;
-      y[3][i] = a.xr + xr_error;
+      y[3][i] = xr_m;
       if (pressures) {
         y[4][i] = a.p1;
         y[5][i] = a.p2;
@@ -536,37 +619,16 @@ class QuarterCarModel : public RigModel {
       // The tyre load is driven by the wheel's true position: the measured
       // x_w less the candidate's transducer offset b_w (1840 N per 2 mm of
       // offset at kt, which the pressures show).
-      const double xw0 = xw_[i] - th[kBw] - (in ? in->at(kSensorXw, i) : 0.0);
-      const double xw1 = (i + 1 < n ? xw_[i + 1] : xw_[i]) - th[kBw] - (in ? in->at(kSensorXw, std::min(i + 1, n - 1)) : 0.0);
+      const double xw0 = xw_in[i] - th[kBw] - (in ? in->at(kSensorXw, i) : 0.0);
+      const double xw1 = (i + 1 < n ? xw_in[i + 1] : xw_in[i]) - th[kBw] -
+                         (in ? in->at(kSensorXw, std::min(i + 1, n - 1)) : 0.0);
       const Extra x = in ? Extra{in->at(kOnRod, i), in->at(kOnSpool, i), in->at(kCrossPort, i),
                                  in->at(kIntoChamber1, i), in->at(kIntoChamber2, i)}
                          : Extra{};
       const double vw = (xw1 - xw0) / dt_;
       for (int k = 0; k < sub; ++k) {
         const double xw = xw0 + (xw1 - xw0) * (k + 0.5) / sub;
-        Act k1, k2, k3, k4;
-        actuator_derivatives(th, a, u, xw, vw, k1, x);
-        actuator_derivatives(th, axpy(a, 0.5 * h, k1), u, xw, vw, k2, x);
-        actuator_derivatives(th, axpy(a, 0.5 * h, k2), u, xw, vw, k3, x);
-        actuator_derivatives(th, axpy(a, h, k3), u, xw, vw, k4, x);
-        a.xs += h / 6.0 * (k1.xs + 2 * k2.xs + 2 * k3.xs + k4.xs);
-        a.p1 += h / 6.0 * (k1.p1 + 2 * k2.p1 + 2 * k3.p1 + k4.p1);
-        a.p2 += h / 6.0 * (k1.p2 + 2 * k2.p2 + 2 * k3.p2 + k4.p2);
-        a.xr += h / 6.0 * (k1.xr + 2 * k2.xr + 2 * k3.xr + k4.xr);
-        a.vr += h / 6.0 * (k1.vr + 2 * k2.vr + 2 * k3.vr + k4.vr);
-        a.p1 = std::max(a.p1, p_.cavitation_pressure);
-        a.p2 = std::max(a.p2, p_.cavitation_pressure);
-        // The seal's Coulomb friction, split from the RK4 step and applied
-        // implicitly (Moreau), so the rod can stick: a seal's step is sharp
-        // (1-10 mm/s) against the 5 kg rod, a slope RK4 at 0.5 ms cannot
-        // take smoothly. The earlier tanh(v_r / 0.02 m/s) was what RK4
-        // could: it gained 0.98 pp against the 1 pp floor on the sweep's
-        // strong Stribeck-form seal (1.16 pp now) and 1.58 on the Simscape
-        // form (1.92 now).
-        if (seal_in) {
-          const double level = std::max(0.0, th[kSealFm] + th[kSealPc] * (std::max(0.0, a.p1 + a.p2) - seal_sum_));
-          a.vr = implicit_velocity(p_.mass_rod, a.vr, 0.0, h, level, level, 0.0, 0.0);
-        }
+        rk4_substep(th, a, u, xw, vw, h, x, seal_in);
       }
       if (!std::isfinite(a.xr) || !std::isfinite(a.p1) || !std::isfinite(a.p2)) {
         for (std::size_t j = i; j < n; ++j)
