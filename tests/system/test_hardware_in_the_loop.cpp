@@ -176,8 +176,17 @@ TEST_F(HardwareInTheLoop, StepTestWithTheCanopenValveInLockStepMatchesTheInProce
 TEST_F(HardwareInTheLoop, PacedStepTestOverModbusTcpCompletesWithTheSimulatedRunsEvents) {
   const int port = start_rig_sim({});
   ASSERT_GT(port, 0);
-  const auto run = run_command(kRigctl + " run " + write_config("modbus", port) + " --log " + path("hw.lcm") +
-                               " --csv " + path("hw.csv"));
+  // A paced run beside other tests on a shared 2-core machine: a reply or a
+  // wake-up the scheduler holds past the wire's deadlines (a 99 ms stall was
+  // seen beside the diagnosis tests) is the machine's, not the wire's. This
+  // test is about a whole paced run over TCP, so the DAQ waits and a sample
+  // may age half a second; the fault tests below keep the deadlines they test.
+  const std::string config = write_config("modbus", port);
+  std::string text = read_file(config);
+  for (const char* key : {"response_timeout_s", "max_sample_age_s"})
+    text = std::regex_replace(text, std::regex(std::string(key) + ": [0-9.]+"), std::string(key) + ": 0.5");
+  std::ofstream(config) << text;
+  const auto run = run_command(kRigctl + " run " + config + " --log " + path("hw.lcm") + " --csv " + path("hw.csv"));
   ASSERT_EQ(run.exit_code, 0) << run.output << sim_->output();
   EXPECT_NE(run.output.find("ended: stopped"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("wake-up latency: p50"), std::string::npos) << run.output;
