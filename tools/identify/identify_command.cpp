@@ -14,25 +14,17 @@
 #include "tools/identify/identify_analysis.hpp"
 #include "tools/identify/mimo_identify.hpp"
 #include "tools/identify/plant_linearisation.hpp"
+#include "tools/identify/identify_run_defaults.hpp"
 #include "tools/run/rig_assembly.hpp"
 
 namespace rigctl {
 
 namespace {
 
-// Held at the operating point after the excitation, so that the run's
-// controlled stop never cuts into it.
-constexpr double kTailS = 0.5;
-
-std::string default_csv_path(const std::string& out_path) {
-  std::filesystem::path p(out_path);
-  p.replace_extension();
-  return p.string() + "-run.csv";
-}
 
 std::unique_ptr<SetpointProfile> excitation_profile(const IdentifyPlan& plan, const Excitation& e) {
   return std::make_unique<ExcitationProfile>(lead_in_to(plan.config, plan.operating_point), plan.settle_s, e.values,
-                                             plan.config.loop.period_s, kTailS);
+                                             plan.config.loop.period_s, kIdentifyTailS);
 }
 
 void describe_plan(const IdentifyPlan& plan, std::ostream& out) {
@@ -109,7 +101,7 @@ IdentifyResult run_identify(const IdentifyOptions& o, const std::atomic<bool>& s
   ro.fast = o.fast;
   ro.realtime = o.realtime;
   ro.log_path = o.log_path;
-  ro.csv_path = o.csv_path.empty() ? default_csv_path(o.out_path) : o.csv_path;
+  ro.csv_path = o.csv_path.empty() ? identify_default_csv_path(o.out_path) : o.csv_path;
   ro.profile_override = [&] { return excitation_profile(plan, excitation); };
   result.run = run_rig(plan.config, ro, stop, out);
   if (result.run.loop.final_state == RigState::kFaulted || stop.load()) {

@@ -11,6 +11,7 @@
 #include "tools/identify/channel_view.hpp"
 #include "tools/identify/excitation_profile.hpp"
 #include "tools/identify/identify_analysis.hpp"
+#include "tools/identify/identify_run_defaults.hpp"
 #include "tools/run/rig_assembly.hpp"
 #include "tools/runfile/run_file.hpp"
 
@@ -18,15 +19,6 @@ namespace rigctl {
 
 namespace {
 
-// Held at the operating points after the excitation, so that the run's
-// controlled stop never cuts into it (as the one-channel identification).
-constexpr double kTailS = 0.5;
-
-std::string default_csv_path(const std::string& out_path) {
-  std::filesystem::path p(out_path);
-  p.replace_extension();
-  return p.string() + "-run.csv";
-}
 
 void add_unique(std::vector<std::string>& names, const std::string& n) {
   if (std::find(names.begin(), names.end(), n) == names.end()) names.push_back(n);
@@ -139,7 +131,7 @@ MimoIdentifyResult run_mimo_identify(const IdentifyOptions& o, const std::atomic
     longest = std::max(longest, leads.back().duration());
   }
   auto profile = [&](std::size_t i) {
-    return std::make_unique<ExcitationProfile>(leads[i], plan.settle_s + longest - leads[i].duration(), played[i], dt, kTailS);
+    return std::make_unique<ExcitationProfile>(leads[i], plan.settle_s + longest - leads[i].duration(), played[i], dt, kIdentifyTailS);
   };
 
   RunOptions ro;
@@ -148,7 +140,7 @@ MimoIdentifyResult run_mimo_identify(const IdentifyOptions& o, const std::atomic
   ro.fast = o.fast;
   ro.realtime = o.realtime;
   ro.log_path = o.log_path;
-  ro.csv_path = o.csv_path.empty() ? default_csv_path(o.out_path) : o.csv_path;
+  ro.csv_path = o.csv_path.empty() ? identify_default_csv_path(o.out_path) : o.csv_path;
   ro.profile_override = [&] { return profile(0); };
   ro.more_profile_override = [&](std::size_t i) { return profile(i); };
   result.run = run_rig(plan.config, ro, stop, out);
