@@ -1,6 +1,8 @@
 #include "tools/identify/excitation_profile.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace rigctl {
 
@@ -24,6 +26,17 @@ double ExcitationProfile::at(double t) const noexcept {
 
 double ExcitationProfile::duration() const noexcept {
   return excitation_start_s() + static_cast<double>(excitation_.size()) * period_s_ + tail_s_;
+}
+
+AlignedExcitation::AlignedExcitation(std::vector<LeadIn> leads, std::vector<std::vector<double>> signals,
+                                     double settle_s, double period_s, double tail_s)
+    : leads_(std::move(leads)), signals_(std::move(signals)), settle_s_(settle_s), period_s_(period_s), tail_s_(tail_s) {
+  for (const LeadIn& l : leads_) longest_s_ = std::max(longest_s_, l.duration());
+}
+
+std::unique_ptr<ExcitationProfile> AlignedExcitation::profile(std::size_t channel) const {
+  return std::make_unique<ExcitationProfile>(leads_.at(channel), hold_s(channel), signals_.at(channel), period_s_,
+                                             tail_s_);
 }
 
 }  // namespace rigctl

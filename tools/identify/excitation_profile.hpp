@@ -4,6 +4,7 @@
 // the operating point again until the run's controlled stop.
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include "config/rig_config.hpp"
@@ -34,6 +35,23 @@ class ExcitationProfile final : public SetpointProfile {
   std::vector<double> excitation_;
   double period_s_;
   double tail_s_;
+};
+
+// Several channels' signals, each after its own lead-in, started on the
+// same tick: a channel with a shorter lead-in holds its operating point the
+// longer (settle_s plus the difference to the longest lead-in).
+class AlignedExcitation {
+ public:
+  AlignedExcitation(std::vector<LeadIn> leads, std::vector<std::vector<double>> signals, double settle_s,
+                    double period_s, double tail_s);
+  std::unique_ptr<ExcitationProfile> profile(std::size_t channel) const;
+  // How long the channel holds its operating point between its lead-in and its signal [s].
+  double hold_s(std::size_t channel) const { return settle_s_ + longest_s_ - leads_.at(channel).duration(); }
+
+ private:
+  std::vector<LeadIn> leads_;
+  std::vector<std::vector<double>> signals_;
+  double settle_s_, period_s_, tail_s_, longest_s_ = 0.0;
 };
 
 }  // namespace rigctl

@@ -125,14 +125,9 @@ MimoIdentifyResult run_mimo_identify(const IdentifyOptions& o, const std::atomic
   // The excitations start together: each channel's hold after its lead-in
   // is lengthened to the longest lead-in.
   std::vector<LeadIn> leads;
-  double longest = 0.0;
-  for (const auto& c : plan.channels) {
-    leads.push_back(lead_in_to(c.config, c.operating_point));
-    longest = std::max(longest, leads.back().duration());
-  }
-  auto profile = [&](std::size_t i) {
-    return std::make_unique<ExcitationProfile>(leads[i], plan.settle_s + longest - leads[i].duration(), played[i], dt, kIdentifyTailS);
-  };
+  for (const auto& c : plan.channels) leads.push_back(lead_in_to(c.config, c.operating_point));
+  const AlignedExcitation aligned(std::move(leads), played, plan.settle_s, dt, kIdentifyTailS);
+  auto profile = [&](std::size_t i) { return aligned.profile(i); };
 
   RunOptions ro;
   ro.config_path = o.config_path;

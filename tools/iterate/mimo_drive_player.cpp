@@ -6,6 +6,7 @@
 
 #include "tools/identify/channel_view.hpp"
 #include "tools/identify/excitation_profile.hpp"
+#include "tools/identify/identify_run_defaults.hpp"
 #include "tools/identify/identify_analysis.hpp"
 #include "tools/run/rig_assembly.hpp"
 #include "tools/run/run_command.hpp"
@@ -15,7 +16,6 @@ namespace rigctl {
 
 namespace {
 
-constexpr double kTailS = 0.5;  // as the one-channel player's
 
 }  // namespace
 
@@ -29,16 +29,13 @@ MimoPlayResult play_drives(const RigConfig& config, const std::vector<std::vecto
   const double dt = config.loop.period_s;
   std::vector<std::vector<double>> deviation(n);
   std::vector<LeadIn> leads;
-  double longest = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
     if (drives[i].size() != drives.front().size()) throw std::invalid_argument("play: drives of different lengths");
     for (double v : drives[i]) deviation[i].push_back(v - ops[i]);
     leads.push_back(lead_in_to(channel_view(config, i), ops[i]));
-    longest = std::max(longest, leads.back().duration());
   }
-  auto profile = [&](std::size_t i) {
-    return std::make_unique<ExcitationProfile>(leads[i], s.settle_s + longest - leads[i].duration(), deviation[i], dt, kTailS);
-  };
+  const AlignedExcitation aligned(std::move(leads), deviation, s.settle_s, dt, kIdentifyTailS);
+  auto profile = [&](std::size_t i) { return aligned.profile(i); };
   RunOptions ro;
   ro.config_path = config.file;
   ro.case_name = config.case_name;
@@ -63,7 +60,7 @@ MimoPlayResult play_drives(const RigConfig& config, const std::vector<std::vecto
     if (std::find(columns.required.begin(), columns.required.end(), c) == columns.required.end()) columns.required.push_back(c);
   }
   const RunFile run = read_run_file(s.csv_path, columns);
-  const auto settle_ticks = static_cast<std::size_t>(std::lround((s.settle_s + longest - leads[0].duration()) / run.dt));
+  const auto settle_ticks = static_cast<std::size_t>(std::lround(aligned.hold_s(0) / run.dt));
   const std::size_t start = find_excitation_start(run.col(first), ops[0], deviation[0], settle_ticks);
   for (const auto& c : channels) {
     const auto& y = run.col(c);
